@@ -1,0 +1,31 @@
+"""The ``agv-fleet`` command line: one sub-command per module, errors as one line."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from fleet import plan_command
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="agv-fleet",
+        description="Simulate AGV fleets running the improved-A* + DWA fusion planner.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    plan_command.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.handler(args)
+    except KeyboardInterrupt:
+        print("agv-fleet: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
