@@ -143,7 +143,8 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
     n = height * width
     g = np.full(n, np.inf)
     parent = np.full(n, -1, np.int32)
-    closed = np.zeros(n, np.uint8)
+    # one byte per cell: 0 open or unseen, 1 obstacle, 2 closed (one load per neighbour)
+    state = blocked.ravel().copy()
     heap = np.empty((4096, 3), np.float64)
     size = 0
     # k of Eq. (3): cells of the rectangle spanned by start and goal
@@ -157,9 +158,9 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
     expansions = 0
     while size > 0:
         node, size = _heap_pop(heap, size)
-        if closed[node]:
+        if state[node] == 2:
             continue
-        closed[node] = 1
+        state[node] = 2
         if node == goal:
             break
         expansions += 1
@@ -177,7 +178,10 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
         for d in range(n_dirs):
             cc = c + _DCOL[d]
             rr = r + _DROW[d]
-            if cc < 0 or cc >= width or rr < 0 or rr >= height or blocked[rr, cc]:
+            if cc < 0 or cc >= width or rr < 0 or rr >= height:
+                continue
+            nb = rr * width + cc
+            if state[nb]:
                 continue
             if d >= 4:
                 if not corner_cutting and (blocked[r, cc] or blocked[rr, c]):
@@ -185,9 +189,6 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
                 step = SQRT2
             else:
                 step = 1.0
-            nb = rr * width + cc
-            if closed[nb]:
-                continue
             ng = g_node + step
             if ng >= g[nb]:
                 continue
@@ -208,7 +209,7 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
                 h = math.exp(p / k) * h
             heap, size = _heap_push(heap, size, ng + h, h, nb)
 
-    if not closed[goal]:
+    if state[goal] != 2:
         return np.empty(0, np.int64), expansions
     length = 1
     node = goal
