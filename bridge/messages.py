@@ -1,0 +1,188 @@
+"""The fleet's message types: plain dataclasses with a dict form for the wire.
+
+Every message crosses the bus and goes into recordings as JSON; ``to_dict``
+and ``from_dict`` are the only codec, and ``json_schema`` derives the JSON
+Schema that the recorder stores with each channel. Nothing here imports zenoh,
+so the in-process mode uses the same types.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import types
+import typing
+from dataclasses import dataclass, field
+
+AGV_STATUSES = ("driving", "arrived", "blocked", "failed")
+
+
+@dataclass
+class AgvState:
+    """Pose (world frame) and body-frame command of one AGV at a tick."""
+
+    name: str
+    tick: int
+    x: float
+    y: float
+    theta: float
+    vx: float
+    vy: float
+    omega: float
+    radius: float
+    status: str = "driving"
+    target: list[float] | None = None
+    plan_time_ms: float = 0.0
+
+
+@dataclass
+class ObstacleState:
+    """A moving obstacle at a tick: world-frame position and velocity."""
+
+    name: str
+    x: float
+    y: float
+    vx: float
+    vy: float
+    radius: float
+
+
+@dataclass
+class Tick:
+    """The world's clock: tick k at time t with every AGV and obstacle."""
+
+    tick: int
+    time: float
+    agvs: list[AgvState]
+    moving: list[ObstacleState] = field(default_factory=list)
+    temporary: list[list[int]] = field(default_factory=list)
+
+
+@dataclass
+class PlanMsg:
+    """A global plan of one AGV: the first one or a replan."""
+
+    name: str
+    tick: int
+    time: float
+    algorithm: str
+    reason: str
+    found: bool
+    path: list[list[float]]
+    key_nodes: list[list[float]]
+    length: float
+    turns: int
+    turning_angle_deg: float
+    plan_time_ms: float
+
+
+@dataclass
+class TrajectoryMsg:
+    """DWA's chosen predicted trajectory for one control cycle."""
+
+    name: str
+    tick: int
+    points: list[list[float]]
+
+
+@dataclass
+class Event:
+    """Something that happened in the world: collision, arrival, failure, run end."""
+
+    tick: int
+    time: float
+    kind: str
+    agvs: list[str] = field(default_factory=list)
+    detail: str = ""
+
+
+MESSAGE_TYPES = (AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event)
+
+
+class MessageError(ValueError):
+    """A payload that does not decode to the expected message type."""
+
+
+def to_dict(msg) -> dict:
+    return dataclasses.asdict(msg)
+
+
+def from_dict(cls, data):
+    """Build ``cls`` from a decoded JSON object, checking every field's type."""
+    if not isinstance(data, dict):
+        raise MessageError(f"{cls.__name__}: expected an object, got {type(data).__name__}")
+    hints = typing.get_type_hints(cls)
+    kwargs = {}
+    for f in dataclasses.fields(cls):
+        if f.name not in data:
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                raise MessageError(f"{cls.__name__}: missing field {f.name!r}")
+            continue
+        kwargs[f.name] = _convert(hints[f.name], data[f.name], f"{cls.__name__}.{f.name}")
+    extra = set(data) - {f.name for f in dataclasses.fields(cls)}
+    if extra:
+        raise MessageError(f"{cls.__name__}: unknown field {sorted(extra)[0]!r}")
+    return cls(**kwargs)
+
+
+def _convert(hint, value, where):
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        if value is None and type(None) in typing.get_args(hint):
+            return None
+        (inner,) = [a for a in typing.get_args(hint) if a is not type(None)]
+        return _convert(inner, value, where)
+    if origin is list:
+        if not isinstance(value, list):
+            raise MessageError(f"{where}: expected a list")
+        (inner,) = typing.get_args(hint)
+        return [_convert(inner, v, f"{where}[{i}]") for i, v in enumerate(value)]
+    if dataclasses.is_dataclass(hint):
+        return from_dict(hint, value)
+    if hint is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise MessageError(f"{where}: expected a number, got {value!r}")
+        return float(value)
+    if hint is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise MessageError(f"{where}: expected an integer, got {value!r}")
+        return value
+    if hint is str:
+        if not isinstance(value, str):
+            raise MessageError(f"{where}: expected a string, got {value!r}")
+        return value
+    if hint is bool:
+        if not isinstance(value, bool):
+            raise MessageError(f"{where}: expected true or false, got {value!r}")
+        return value
+    raise TypeError(f"{where}: unsupported field type {hint!r}")
+
+
+def json_schema(cls) -> dict:
+    """JSON Schema (draft 2020-12) of a message type."""
+    schema = _schema_of(cls)
+    schema["$schema"] = "https://json-schema.org/draft/2020-12/schema"
+    schema["title"] = cls.__name__
+    return schema
+
+
+def _schema_of(hint) -> dict:
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        (inner,) = [a for a in typing.get_args(hint) if a is not type(None)]
+        return {"anyOf": [_schema_of(inner), {"type": "null"}]}
+    if origin is list:
+        return {"type": "array", "items": _schema_of(typing.get_args(hint)[0])}
+    if dataclasses.is_dataclass(hint):
+        hints = typing.get_type_hints(hint)
+        fields = dataclasses.fields(hint)
+        return {
+            "type": "object",
+            "properties": {f.name: _schema_of(hints[f.name]) for f in fields},
+            "required": [
+                f.name
+                for f in fields
+                if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+            ],
+            "additionalProperties": False,
+        }
+    return {"type": {float: "number", int: "integer", str: "string", bool: "boolean"}[hint]}

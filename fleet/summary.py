@@ -1,0 +1,105 @@
+"""The end-of-run summary: per AGV and for the run, as a table or as JSON."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fleet.world import World
+
+
+@dataclass(frozen=True)
+class AgvSummary:
+    name: str
+    status: str
+    arrival_time: float | None
+    distance: float
+    collisions: int
+    min_clearance: float
+    failure: str = ""
+
+
+@dataclass(frozen=True)
+class RunSummary:
+    scenario: str
+    sim_time: float
+    wall_time: float
+    ticks: int
+    collisions: int
+    end_reason: str
+    agvs: tuple[AgvSummary, ...]
+
+    @property
+    def success(self) -> bool:
+        """Every AGV arrived and nothing collided."""
+        return self.collisions == 0 and all(a.status == "arrived" for a in self.agvs)
+
+    def to_json(self) -> dict:
+        return {
+            "scenario": self.scenario,
+            "sim_time": round(self.sim_time, 6),
+            "wall_time": round(self.wall_time, 3),
+            "ticks": self.ticks,
+            "collisions": self.collisions,
+            "end_reason": self.end_reason,
+            "agvs": [
+                {
+                    "name": a.name,
+                    "status": a.status,
+                    "arrival_time": a.arrival_time,
+                    "distance": round(a.distance, 4),
+                    "collisions": a.collisions,
+                    "min_clearance": round(a.min_clearance, 4)
+                    if math.isfinite(a.min_clearance)
+                    else None,
+                    **({"failure": a.failure} if a.failure else {}),
+                }
+                for a in self.agvs
+            ],
+        }
+
+    def table(self) -> str:
+        header = ("AGV", "status", "arrival (s)", "distance (m)", "collisions", "min clearance (m)")
+        rows = [header]
+        for a in self.agvs:
+            rows.append(
+                (
+                    a.name,
+                    a.status,
+                    "-" if a.arrival_time is None else f"{a.arrival_time:.1f}",
+                    f"{a.distance:.2f}",
+                    str(a.collisions),
+                    f"{a.min_clearance:.2f}",
+                )
+            )
+        widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
+        lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+        lines.insert(1, "  ".join("-" * w for w in widths))
+        arrived = sum(a.status == "arrived" for a in self.agvs)
+        lines.append(
+            f"{self.scenario}: {arrived}/{len(self.agvs)} arrived, {self.collisions} collisions, "
+            f"{self.sim_time:.1f} s simulated in {self.wall_time:.2f} s ({self.end_reason})"
+        )
+        return "\n".join(lines)
+
+
+def summarize(world: World, wall_time: float) -> RunSummary:
+    agvs = []
+    for name, r in world.records.items():
+        status = r.status
+        if status not in ("arrived", "failed"):
+            status = "timeout" if world.end_reason == "time limit" else status
+        agvs.append(
+            AgvSummary(
+                name, status, r.arrival_time, r.distance, r.collisions, r.min_clearance, r.failure
+            )
+        )
+    return RunSummary(
+        scenario=world.scenario.name,
+        sim_time=world.time,
+        wall_time=wall_time,
+        ticks=world.tick,
+        collisions=world.collisions,
+        end_reason=world.end_reason,
+        agvs=tuple(agvs),
+    )

@@ -1,0 +1,347 @@
+"""The dynamic window approach (DWA) for an omnidirectional AGV (Guo et al. 2023, section 3).
+
+State (x, y, theta) in the world frame; command (vx, vy, omega) in the body
+frame, moved by the motion model Eq. (4). Units are SI throughout: metres,
+seconds, radians (so 20 deg/s is ``math.radians(20)``).
+
+One control cycle (``DwaPlanner.plan``):
+
+1. Window (Eqs. 5, 6): per axis, the speed limits intersected with what one
+   control period of acceleration reaches from the current command, sampled
+   on the resolution grid centred on the current command (so the current
+   command is always a sample), then the samples faster than ``max_speed``
+   in |(vx, vy)| are dropped.
+2. Rollout: every sample held for ``predict_time``, all samples and steps
+   as arrays; positions are ``vx * C(omega) - vy * S(omega)`` with C, S
+   cumulative sums of the heading's cosine and sine, so trigonometry is only
+   evaluated per distinct omega.
+3. Clearance (a numba kernel): the minimum over the predicted steps of the
+   distance to static obstacles (the DistanceField) and to moving discs
+   predicted at constant velocity, minus the AGV radius.
+4. Admissible (Eq. 7): clearance > 0, speed <= sqrt(2 clearance a_max) and
+   |omega| <= sqrt(2 clearance alpha_max), clearance being the trajectory's
+   minimum (the paper says "from the end of the trajectory"; the minimum is
+   Fox et al.'s definition and the safe one).
+5. Score (Eq. 10) over the admissible samples:
+   G = alpha xhead + beta dist + gamma vel, each term divided by its sum over
+   them; xhead = pi - |heading error| at the trajectory's end towards the
+   local target, the heading being the direction of travel (body heading plus
+   atan2(vy, vx); the body heading when standing) since an omnidirectional
+   AGV need not face where it goes, dist = clearance capped at ``clearance_cap``, vel = speed
+   |(vx, vy)|. The first maximum wins.
+
+When nothing is admissible the command brakes every component towards zero
+as hard as the acceleration limits allow.
+
+Beyond the paper, for arriving (at 0.2 m/s² an AGV at 2 m/s needs 10 m to
+stop, and a 3 s rollout's end lies past a nearby target, so plain DWA circles
+its goal): ``plan(..., reach=r)`` gives full xhead to a trajectory that comes
+within r of the target (its end heading no longer says anything), and
+``stop=True`` drops the samples too fast to brake to zero at the target,
+sqrt(2 a_max d), while always keeping the hardest deceleration the window has.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass, fields
+
+import numba
+import numpy as np
+
+from planner.distance_field import DistanceField, lookup
+
+Pose = tuple[float, float, float]
+Command = tuple[float, float, float]
+
+_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class DwaConfig:
+    """DWA parameters; the defaults are the paper's (Table 1, section 5). SI units, radians."""
+
+    max_speed: float = 2.0  # m/s, limit on |vx|, |vy| and |(vx, vy)|
+    min_vx: float = 0.0  # m/s, lowest vx: 0 no reversing, -max_speed full reversing
+    max_accel: float = 0.2  # m/s², per linear axis
+    max_omega: float = math.radians(20.0)  # rad/s
+    max_alpha: float = math.radians(50.0)  # rad/s², angular acceleration
+    v_resolution: float = 0.01  # m/s
+    omega_resolution: float = math.radians(1.0)  # rad/s
+    dt: float = 0.1  # s, control period and rollout step
+    predict_time: float = 3.0  # s, rollout horizon
+    alpha: float = 0.1  # weight of xhead
+    beta: float = 0.2  # weight of dist
+    gamma: float = 0.2  # weight of vel
+    radius: float = 0.3  # m, AGV disc radius
+    clearance_cap: float = 2.0  # m, largest clearance credited by the dist term
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not (isinstance(value, numbers.Real) and math.isfinite(value)):
+                raise ValueError(f"DWA {f.name} must be a finite number, got {value!r}")
+        positive = (
+            "max_speed", "max_accel", "max_omega", "max_alpha", "v_resolution",
+            "omega_resolution", "dt", "predict_time", "radius", "clearance_cap",
+        )  # fmt: skip
+        for name in positive:
+            if not getattr(self, name) > 0:
+                raise ValueError(f"DWA {name} must be > 0, got {getattr(self, name)}")
+        for name in ("alpha", "beta", "gamma"):
+            if getattr(self, name) < 0:
+                raise ValueError(f"DWA weight {name} must be >= 0, got {getattr(self, name)}")
+        if not -self.max_speed <= self.min_vx <= 0:
+            raise ValueError(
+                f"DWA min_vx must lie in [-max_speed, 0] = [{-self.max_speed}, 0] "
+                f"(the AGV must be able to stop), got {self.min_vx}"
+            )
+        if self.predict_time < self.dt - _EPS:
+            raise ValueError(
+                f"DWA predict_time ({self.predict_time} s) must be at least dt ({self.dt} s)"
+            )
+
+    @property
+    def steps(self) -> int:
+        """Rollout steps over the horizon."""
+        return max(1, round(self.predict_time / self.dt))
+
+
+def step_pose(pose: Pose, command: Command, dt: float) -> Pose:
+    """Eq. (4): ``pose`` after ``dt`` under the body-frame ``command``, theta in [-pi, pi]."""
+    x, y, theta = pose
+    vx, vy, omega = command
+    c, s = math.cos(theta), math.sin(theta)
+    return (
+        x + (vx * c - vy * s) * dt,
+        y + (vx * s + vy * c) * dt,
+        math.remainder(theta + omega * dt, math.tau),
+    )
+
+
+def wrap_angle(angle):
+    """Angles wrapped to [-pi, pi)."""
+    return np.remainder(np.asarray(angle) + np.pi, 2 * np.pi) - np.pi
+
+
+@dataclass(frozen=True)
+class DwaResult:
+    """The outcome of one control cycle.
+
+    ``trajectory`` (K x 3) holds the predicted poses after each of the K
+    rollout steps of the chosen command (for the braking command when
+    nothing is admissible).
+    """
+
+    command: Command
+    trajectory: np.ndarray
+    samples: int
+    admissible_samples: int
+
+    @property
+    def admissible(self) -> bool:
+        """False when no sample was admissible and the command is the braking fallback."""
+        return self.admissible_samples > 0
+
+
+def window_axis(current: float, lowest: float, highest: float, reach: float, step: float):
+    """One command axis: [lowest, highest] ∩ [current ± reach], on a grid through ``current``.
+
+    A ``current`` on the resolution grid (as every command DWA chose from rest
+    is) snaps to it, so that stopping is exactly 0 and the samples do not
+    drift with rounding. If ``current`` lies outside the limits by more than
+    ``reach``, the only sample is the value one period closer to them.
+    """
+    lo, hi = max(lowest, current - reach), min(highest, current + reach)
+    if lo > hi + _EPS:
+        return np.array([current - reach if current > highest else current + reach])
+    centre = min(max(current, lo), hi)
+    offsets = np.arange(
+        -math.floor((centre - lo) / step + _EPS), math.floor((hi - centre) / step + _EPS) + 1
+    )
+    nearest = round(centre / step)
+    if abs(centre / step - nearest) < 1e-6:  # on the resolution grid: no rounding drift, exact 0
+        return (nearest + offsets) * step
+    return centre + step * offsets
+
+
+def dynamic_window(config: DwaConfig, command: Command) -> np.ndarray:
+    """(N, 3) sampled commands of the window (Eqs. 5, 6), speed-limited in |(vx, vy)|."""
+    vx, vy, omega = command
+    dv = config.max_accel * config.dt
+    vxs = window_axis(vx, config.min_vx, config.max_speed, dv, config.v_resolution)
+    vys = window_axis(vy, -config.max_speed, config.max_speed, dv, config.v_resolution)
+    omegas = window_axis(
+        omega, -config.max_omega, config.max_omega, config.max_alpha * config.dt,
+        config.omega_resolution,
+    )  # fmt: skip
+    grid = np.stack(np.meshgrid(vxs, vys, omegas, indexing="ij"), axis=-1).reshape(-1, 3)
+    return grid[np.hypot(grid[:, 0], grid[:, 1]) <= config.max_speed + _EPS]
+
+
+def braking_command(config: DwaConfig, command: Command) -> Command:
+    """Every component towards zero by at most one period of acceleration."""
+    dv, dw = config.max_accel * config.dt, config.max_alpha * config.dt
+    vx, vy, omega = command
+    return (
+        math.copysign(max(abs(vx) - dv, 0.0), vx),
+        math.copysign(max(abs(vy) - dv, 0.0), vy),
+        math.copysign(max(abs(omega) - dw, 0.0), omega),
+    )
+
+
+def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarray:
+    """(3, N, K): x, y and theta after steps 1..K of each command held constant (Eq. 4)."""
+    x0, y0, theta0 = pose
+    omegas, which = np.unique(commands[:, 2], return_inverse=True)
+    headings = theta0 + omegas[:, None] * (np.arange(steps + 1) * dt)  # (W, K+1), steps 0..K
+    # the displacement of step k uses the heading at its start (step k-1)
+    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)[which] * dt
+    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)[which] * dt
+    vx, vy = commands[:, 0:1], commands[:, 1:2]
+    out = np.empty((3, len(commands), steps))
+    out[0] = x0 + vx * cos_sum - vy * sin_sum
+    out[1] = y0 + vx * sin_sum + vy * cos_sum
+    out[2] = headings[which, 1:]
+    return out
+
+
+@numba.njit(cache=True)
+def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius):
+    """(N,) minimum over steps of the clearance of trajectories ``xs``, ``ys`` (N, K).
+
+    Static: the distance field minus ``radius``. Moving discs (M, 5) rows
+    [x, y, vx, vy, r], at step k (time (k+1) dt) at constant velocity:
+    centre distance minus r minus ``radius``. A trajectory stops being
+    evaluated at its first contact (its clearance is then <= 0, which is all
+    that matters).
+    """
+    n_traj, n_steps = xs.shape
+    out = np.empty(n_traj)
+    for n in range(n_traj):
+        worst = np.inf
+        for k in range(n_steps):
+            x, y, t = xs[n, k], ys[n, k], (k + 1) * dt
+            c = lookup(samples, inv_spacing, x, y) - radius
+            for m in range(moving.shape[0]):
+                dx = x - (moving[m, 0] + moving[m, 2] * t)
+                dy = y - (moving[m, 1] + moving[m, 3] * t)
+                c = min(c, math.sqrt(dx * dx + dy * dy) - moving[m, 4] - radius)
+            worst = min(worst, c)
+            if worst <= 0.0:
+                break
+        out[n] = worst
+    return out
+
+
+def admissible_mask(config: DwaConfig, commands: np.ndarray, clearance: np.ndarray) -> np.ndarray:
+    """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance."""
+    room = np.maximum(clearance, 0.0)
+    return (
+        (clearance > 0.0)
+        & (
+            np.hypot(commands[:, 0], commands[:, 1])
+            <= np.sqrt(2.0 * room * config.max_accel) + _EPS
+        )
+        & (np.abs(commands[:, 2]) <= np.sqrt(2.0 * room * config.max_alpha) + _EPS)
+    )
+
+
+def normalised(term: np.ndarray) -> np.ndarray:
+    """``term`` divided by its sum (all zeros when the sum is zero)."""
+    total = term.sum()
+    return term / total if total > 0 else np.zeros_like(term)
+
+
+def scores(
+    config: DwaConfig,
+    commands: np.ndarray,
+    end: tuple[np.ndarray, np.ndarray, np.ndarray],
+    clearance: np.ndarray,
+    target_xy: tuple[float, float],
+    reached: np.ndarray | None = None,
+) -> np.ndarray:
+    """Eq. (10) for admissible samples: alpha xhead + beta dist + gamma vel, each normalised.
+
+    ``end`` is the trajectories' final (x, y, theta), ``clearance`` their minimum
+    clearance; ``reached`` marks trajectories that pass the target (full xhead).
+    """
+    end_x, end_y, end_theta = end
+    bearing = np.arctan2(target_xy[1] - end_y, target_xy[0] - end_x)
+    # an omnidirectional AGV travels at atan2(vy, vx) from its heading: that
+    # direction, not the body heading, is what must point at the target
+    moving = np.hypot(commands[:, 0], commands[:, 1]) > _EPS
+    travel = end_theta + np.where(moving, np.arctan2(commands[:, 1], commands[:, 0]), 0.0)
+    xhead = np.pi - np.abs(wrap_angle(bearing - travel))
+    if reached is not None:
+        xhead = np.where(reached, np.pi, xhead)
+    dist = np.minimum(clearance, config.clearance_cap)
+    vel = np.hypot(commands[:, 0], commands[:, 1])
+    return (
+        config.alpha * normalised(xhead)
+        + config.beta * normalised(dist)
+        + config.gamma * normalised(vel)
+    )
+
+
+class DwaPlanner:
+    """DWA over a static DistanceField (assignable: temporary obstacles become known)."""
+
+    def __init__(self, config: DwaConfig, distance_field: DistanceField):
+        self.config = config
+        self.distance_field = distance_field
+
+    def plan(
+        self,
+        pose: Pose,
+        command: Command,
+        target_xy: tuple[float, float],
+        moving: np.ndarray | None = None,
+        *,
+        reach: float = 0.0,
+        stop: bool = False,
+    ) -> DwaResult:
+        """One control cycle from ``pose`` with current ``command`` towards the local target.
+
+        ``moving``: (M, 5) discs [x, y, vx, vy, radius] in the world frame (other
+        AGVs, moving obstacles), or None. ``reach``: a trajectory within this
+        distance of the target scores full xhead. ``stop``: brake to arrive at
+        the target at rest (the final goal).
+        """
+        cfg = self.config
+        field = self.distance_field
+        discs = np.zeros((0, 5)) if moving is None else np.asarray(moving, dtype=float)
+        discs = np.ascontiguousarray(discs.reshape(-1, 5))
+        commands = dynamic_window(cfg, command)
+        xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps)
+        clearance = min_clearance(
+            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+        )
+        mask = admissible_mask(cfg, commands, clearance)
+        if stop:
+            speed = np.hypot(commands[:, 0], commands[:, 1])
+            room = math.dist(pose[:2], target_xy)
+            limit = max(math.sqrt(2.0 * cfg.max_accel * room), float(speed.min()))
+            mask &= speed <= limit + _EPS
+        ok = np.flatnonzero(mask)
+        if ok.size == 0:
+            brake = braking_command(cfg, command)
+            path = rollout(pose, np.array([brake]), cfg.dt, cfg.steps)[:, 0, :]
+            return DwaResult(brake, _poses(path), len(commands), 0)
+        end = (xs[ok, -1], ys[ok, -1], thetas[ok, -1])
+        reached = None
+        if reach > 0:
+            gap2 = (xs[ok] - target_xy[0]) ** 2 + (ys[ok] - target_xy[1]) ** 2
+            reached = gap2.min(axis=1) <= reach * reach
+        g = scores(cfg, commands[ok], end, clearance[ok], target_xy, reached)
+        best = ok[int(np.argmax(g))]
+        chosen = tuple(float(v) for v in commands[best])
+        return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+
+def _poses(path) -> np.ndarray:
+    """(K, 3) poses from x, y, theta rows, theta wrapped to [-pi, pi)."""
+    out = np.column_stack(path)
+    out[:, 2] = wrap_angle(out[:, 2])
+    return out

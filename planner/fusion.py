@@ -1,0 +1,198 @@
+"""The fusion controller of Guo et al. 2023 (section 4) and its two comparison variants.
+
+One controller per AGV. It plans globally once, then every control cycle
+runs DWA towards the current local target:
+
+- ``fusion`` (the paper): improved A* key nodes are the successive local
+  targets, and the initial heading is turned towards the first key node.
+- ``astar-dwa`` (the paper's comparison hybrid, ref. [34]): traditional A*,
+  its turning points as local targets, no initial-heading alignment.
+- ``dwa``: DWA alone, aimed at the final goal; no global plan, no replans.
+
+Target switching: the local target advances to the next key node as soon as
+the AGV is within ``switch_distance`` of it (the final goal never switches;
+the AGV has arrived within ``goal_tolerance`` of it).
+
+Beyond the paper: progress is the remaining route length (to the current
+target, then along the key nodes to the goal). When its best value has not
+dropped by ``progress_distance`` for ``progress_window`` seconds, the
+controller replans globally on the static map plus the temporary obstacles
+seen so far. A replan that finds no path means the goal is unreachable on
+what the AGV knows: status ``failed``. A cycle in which DWA has no admissible
+trajectory (boxed in, braking) reports ``blocked``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from planner.distance_field import DistanceField
+from planner.dwa import DwaConfig, DwaPlanner
+from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
+from planner.grid_map import Cell, GridMap, MapError, Point
+
+VARIANTS = ("fusion", "astar-dwa", "dwa")
+_GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
+
+
+@dataclass(frozen=True)
+class FusionConfig:
+    """Everything one AGV's planner needs; defaults are the paper's."""
+
+    algorithm: str = "fusion"
+    dwa: DwaConfig = field(default_factory=DwaConfig)
+    safety_distance: float = DEFAULT_SAFETY_DISTANCE
+    switch_distance: float = 1.0
+    goal_tolerance: float = 0.2
+    progress_window: float = 5.0
+    progress_distance: float = 0.3
+
+    def __post_init__(self) -> None:
+        if self.algorithm not in VARIANTS:
+            raise ValueError(
+                f"unknown planner algorithm {self.algorithm!r}: choose one of {', '.join(VARIANTS)}"
+            )
+        for name in ("safety_distance", "switch_distance", "goal_tolerance", "progress_window"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+
+
+@dataclass(frozen=True)
+class ControlStep:
+    """The outcome of one control cycle."""
+
+    command: tuple[float, float, float]
+    status: str
+    target: Point | None
+    trajectory: np.ndarray
+    plan: PlanResult | None
+    plan_time_s: float
+
+
+class FusionController:
+    """One AGV's planner: global plan + DWA, stepped once per control period."""
+
+    def __init__(self, grid: GridMap, goal: Point, config: FusionConfig | None = None):
+        self.config = config or FusionConfig()
+        self.grid = grid
+        self.goal = goal
+        self.known_cells: set[Cell] = set()
+        self.targets: list[Point] = []
+        self.target_index = 0
+        self.status = "driving"
+        self.failure = ""
+        self.dwa = DwaPlanner(self.config.dwa, DistanceField.from_grid(grid))
+        self._best_remaining = math.inf
+        self._best_time = 0.0
+
+    # --- planning -----------------------------------------------------------------
+    def start(
+        self, pose: tuple[float, float, float]
+    ) -> tuple[tuple[float, float, float], PlanResult | None]:
+        """Plan from the start pose; returns the (possibly turned) start pose and the plan."""
+        plan = self._plan_from((pose[0], pose[1]))
+        if self.config.algorithm == "fusion" and plan is not None and plan.found:
+            first = self.targets[0]
+            pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
+        return pose, plan
+
+    def _plan_from(self, position: Point) -> PlanResult | None:
+        if self.config.algorithm == "dwa":
+            self.targets = [self.goal]
+            self.target_index = 0
+            return None
+        known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
+        try:
+            plan = plan_global(
+                known,
+                position,
+                self.goal,
+                _GLOBAL_ALGORITHM[self.config.algorithm],
+                safety_distance=self.config.safety_distance,
+            )
+        except MapError as err:  # e.g. standing in a cell now known to be blocked
+            plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
+            self.failure = str(err)
+        if not plan.found:
+            self.failure = self.failure or "no path to the goal on the known map"
+            self.status = "failed"
+            self.targets = []
+            return plan
+        # the start cell's centre is not a target: the AGV is already there; for
+        # astar-dwa the key nodes are the traditional path's turning points
+        self.targets = list(plan.key_nodes[1:]) or [self.goal]
+        self.targets[-1] = self.goal
+        self.target_index = 0
+        return plan
+
+    def see(self, cells) -> bool:
+        """Temporary obstacle cells inside the sensing radius; True when any is new."""
+        new = {tuple(c) for c in cells} - self.known_cells
+        if not new:
+            return False
+        self.known_cells |= new
+        self.dwa.distance_field = DistanceField.from_grid(self.grid.with_blocked(self.known_cells))
+        return True
+
+    # --- control ------------------------------------------------------------------
+    def step(
+        self,
+        pose: tuple[float, float, float],
+        command: tuple[float, float, float],
+        now: float,
+        moving: np.ndarray | None = None,
+    ) -> ControlStep:
+        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]."""
+        t0 = time.perf_counter()
+        stop = (0.0, 0.0, 0.0)
+        if self.status in ("arrived", "failed"):
+            return ControlStep(stop, self.status, None, np.empty((0, 3)), None, 0.0)
+        position = (pose[0], pose[1])
+        if math.dist(position, self.goal) <= self.config.goal_tolerance:
+            self.status = "arrived"
+            return ControlStep(stop, self.status, None, np.empty((0, 3)), None, 0.0)
+        plan = None
+        if self._stalled(position, now) and self.config.algorithm != "dwa":
+            plan = self._plan_from(position)
+            self._best_remaining, self._best_time = math.inf, now
+            if self.status == "failed":
+                return ControlStep(stop, self.status, None, np.empty((0, 3)), plan, 0.0)
+        self._advance_target(position)
+        target = self.targets[self.target_index]
+        final = self.target_index == len(self.targets) - 1
+        reach = self.config.goal_tolerance if final else self.config.switch_distance
+        result = self.dwa.plan(pose, command, target, moving, reach=reach, stop=final)
+        self.status = "blocked" if not result.admissible else "driving"
+        return ControlStep(
+            tuple(float(v) for v in result.command),
+            self.status,
+            target,
+            result.trajectory,
+            plan,
+            time.perf_counter() - t0,
+        )
+
+    def _advance_target(self, position: Point) -> None:
+        last = len(self.targets) - 1
+        while (
+            self.target_index < last
+            and math.dist(position, self.targets[self.target_index]) <= self.config.switch_distance
+        ):
+            self.target_index += 1
+
+    def remaining(self, position: Point) -> float:
+        """Route length left: to the current target, then along the remaining targets."""
+        route = [position, *self.targets[self.target_index :]]
+        return float(sum(math.dist(a, b) for a, b in itertools.pairwise(route)))
+
+    def _stalled(self, position: Point, now: float) -> bool:
+        remaining = self.remaining(position)
+        if remaining < self._best_remaining - self.config.progress_distance:
+            self._best_remaining, self._best_time = remaining, now
+            return False
+        return now - self._best_time >= self.config.progress_window
