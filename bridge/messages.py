@@ -17,6 +17,17 @@ AGV_STATUSES = ("driving", "arrived", "blocked", "failed")
 
 
 @dataclass
+class MapMsg:
+    """The static map of a run: rows top to bottom as printed, '.' free, '#' blocked."""
+
+    name: str
+    width: int
+    height: int
+    resolution: float
+    rows: list[str]
+
+
+@dataclass
 class AgvState:
     """Pose (world frame) and body-frame command of one AGV at a tick."""
 
@@ -95,7 +106,7 @@ class Event:
     detail: str = ""
 
 
-MESSAGE_TYPES = (AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event)
+MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event)
 
 
 class MessageError(ValueError):

@@ -5,10 +5,11 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from bridge import keys
 from fleet.agv_node import AgvNode
 from fleet.scenario import Scenario
 from fleet.summary import RunSummary, summarize
-from fleet.world import World
+from fleet.world import World, map_message
 
 # called with (bus key below the run prefix, message) for every message of the run
 Sink = Callable[[str, object], None]
@@ -22,24 +23,28 @@ def run_in_process(
     t0 = time.perf_counter()
     world = World(scenario)
     nodes = {a.name: AgvNode(scenario, a.name) for a in scenario.agvs}
+    if sink:
+        sink(keys.WORLD_MAP, map_message(scenario.grid))
     tick = world.first_tick()
     while tick is not None:
         if sink:
-            sink("world/tick", tick)
+            sink(keys.WORLD_TICK, tick)
         replies = {}
         for name in world.live_agvs():
             out = nodes[name].on_tick(tick)
             replies[name] = out.state
             if sink:
-                sink(f"agv/{name}/state", out.state)
+                sink(keys.agv_state(name), out.state)
                 if out.plan:
-                    sink(f"agv/{name}/plan", out.plan)
+                    sink(keys.agv_plan(name), out.plan)
                 if out.trajectory:
-                    sink(f"agv/{name}/trajectory", out.trajectory)
+                    sink(keys.agv_trajectory(name), out.trajectory)
         tick = world.advance(replies)
         if sink:
             for event in world.events:
-                sink("world/event", event)
+                sink(keys.WORLD_EVENT, event)
+            if tick is None:
+                sink(keys.WORLD_TICK, world.final_tick())
         if progress:
             progress(world)
     return summarize(world, time.perf_counter() - t0)

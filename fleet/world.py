@@ -14,9 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bridge.messages import AgvState, Event, ObstacleState, Tick
+from bridge.messages import AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.scenario import Scenario
 from planner.distance_field import DistanceField
+from planner.grid_map import GridMap
 
 DONE_STATUSES = ("arrived", "failed")
 
@@ -70,7 +71,11 @@ class World:
         return self._make_tick()
 
     def live_agvs(self) -> list[str]:
-        """AGVs whose answer the next tick waits for."""
+        """AGVs whose answer the next tick waits for: all but the failed ones (an
+        arrived AGV keeps answering, parked, so every tick has every AGV's state)."""
+        return [n for n, r in self.records.items() if r.status != "failed"]
+
+    def _running(self) -> list[str]:
         return [n for n, r in self.records.items() if r.status not in DONE_STATUSES]
 
     def advance(self, replies: dict[str, AgvState]) -> Tick | None:
@@ -87,11 +92,11 @@ class World:
             record.distance += math.hypot(reply.x - old.x, reply.y - old.y)
             reply.tick = self.tick
             self.states[name] = reply
-            if reply.status in DONE_STATUSES:
+            if reply.status in DONE_STATUSES and record.status not in DONE_STATUSES:
                 self._finish(name, reply.status, reply.status)
         self._refresh_temporary()
         self._check_contacts()
-        if not self.live_agvs():
+        if not self._running():
             self._end("every AGV is done")
         elif self.time >= self.scenario.time_limit - 1e-9:
             self._end("time limit")
@@ -185,3 +190,8 @@ class World:
                 Event(self.tick, self.time, "collision", involved, " and ".join(sorted(pair)))
             )
         self._contacts = contacts
+
+
+def map_message(grid: GridMap) -> MapMsg:
+    """The static map as published on ``world/map`` and recorded."""
+    return MapMsg(grid.name, grid.width, grid.height, grid.resolution, grid.to_text().split("\n"))

@@ -82,7 +82,8 @@ def test_arrivals_and_failures_end_the_run():
     world = World(parse_scenario(SCENARIO))
     world.first_tick()
     tick = world.advance({"a": moved(world, "a", 8.5, 1.5, "arrived"), "b": world.states["b"]})
-    assert world.records["a"].arrival_time == 0.5 and world.live_agvs() == ["b"]
+    assert world.records["a"].arrival_time == 0.5
+    assert world.live_agvs() == ["a", "b"]  # an arrived AGV keeps answering, parked
     assert tick is not None
     world.mark_failed("b", "lost liveliness")
     assert world.advance({}) is None
