@@ -9,6 +9,7 @@ so the in-process mode uses the same types.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import types
 import typing
 from dataclasses import dataclass, field
@@ -59,13 +60,17 @@ class ObstacleState:
 
 @dataclass
 class Tick:
-    """The world's clock: tick k at time t with every AGV and obstacle."""
+    """The world's clock: tick k at time t with every AGV and obstacle.
+
+    ``final`` marks the last tick of a run: the end state, which nobody answers.
+    """
 
     tick: int
     time: float
     agvs: list[AgvState]
     moving: list[ObstacleState] = field(default_factory=list)
     temporary: list[list[int]] = field(default_factory=list)
+    final: bool = False
 
 
 @dataclass
@@ -119,53 +124,73 @@ def to_dict(msg) -> dict:
 
 def from_dict(cls, data):
     """Build ``cls`` from a decoded JSON object, checking every field's type."""
-    if not isinstance(data, dict):
-        raise MessageError(f"{cls.__name__}: expected an object, got {type(data).__name__}")
+    return _decoder(cls)(data, cls.__name__)
+
+
+@functools.cache
+def _decoder(cls):
+    """A decoding function for one message class, built once from its type hints
+    (resolving hints per message would cost more than the JSON parse)."""
     hints = typing.get_type_hints(cls)
-    kwargs = {}
+    specs = []
     for f in dataclasses.fields(cls):
-        if f.name not in data:
-            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
-                raise MessageError(f"{cls.__name__}: missing field {f.name!r}")
-            continue
-        kwargs[f.name] = _convert(hints[f.name], data[f.name], f"{cls.__name__}.{f.name}")
-    extra = set(data) - {f.name for f in dataclasses.fields(cls)}
-    if extra:
-        raise MessageError(f"{cls.__name__}: unknown field {sorted(extra)[0]!r}")
-    return cls(**kwargs)
+        required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        specs.append((f.name, required, _converter(hints[f.name])))
+    names = {f.name for f in dataclasses.fields(cls)}
+
+    def decode(data, where):
+        if not isinstance(data, dict):
+            raise MessageError(f"{where}: expected an object, got {type(data).__name__}")
+        kwargs = {}
+        for name, required, convert in specs:
+            if name in data:
+                kwargs[name] = convert(data[name], f"{where}.{name}")
+            elif required:
+                raise MessageError(f"{where}: missing field {name!r}")
+        if len(data) > len(kwargs):
+            extra = sorted(set(data) - names)
+            if extra:
+                raise MessageError(f"{where}: unknown field {extra[0]!r}")
+        return cls(**kwargs)
+
+    return decode
 
 
-def _convert(hint, value, where):
+def _converter(hint):
     origin = typing.get_origin(hint)
     if origin in (typing.Union, types.UnionType):
-        if value is None and type(None) in typing.get_args(hint):
-            return None
         (inner,) = [a for a in typing.get_args(hint) if a is not type(None)]
-        return _convert(inner, value, where)
+        convert_inner = _converter(inner)
+        return lambda v, where: None if v is None else convert_inner(v, where)
     if origin is list:
-        if not isinstance(value, list):
-            raise MessageError(f"{where}: expected a list")
         (inner,) = typing.get_args(hint)
-        return [_convert(inner, v, f"{where}[{i}]") for i, v in enumerate(value)]
+        convert_item = _converter(inner)
+
+        def convert_list(v, where):
+            if not isinstance(v, list):
+                raise MessageError(f"{where}: expected a list")
+            return [convert_item(x, where) for x in v]
+
+        return convert_list
     if dataclasses.is_dataclass(hint):
-        return from_dict(hint, value)
+        return _decoder(hint)
     if hint is float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise MessageError(f"{where}: expected a number, got {value!r}")
-        return float(value)
-    if hint is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise MessageError(f"{where}: expected an integer, got {value!r}")
-        return value
-    if hint is str:
-        if not isinstance(value, str):
-            raise MessageError(f"{where}: expected a string, got {value!r}")
-        return value
-    if hint is bool:
-        if not isinstance(value, bool):
-            raise MessageError(f"{where}: expected true or false, got {value!r}")
-        return value
-    raise TypeError(f"{where}: unsupported field type {hint!r}")
+        return _to_float
+    if hint in (int, str, bool):
+        return functools.partial(_exactly, hint)
+    raise TypeError(f"unsupported field type {hint!r}")
+
+
+def _to_float(v, where):
+    if type(v) is float or (type(v) is int):
+        return float(v)
+    raise MessageError(f"{where}: expected a number, got {v!r}")
+
+
+def _exactly(kind, v, where):
+    if type(v) is not kind:
+        raise MessageError(f"{where}: expected {kind.__name__}, got {v!r}")
+    return v
 
 
 def json_schema(cls) -> dict:

@@ -19,7 +19,7 @@ from bridge.messages import AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
 from planner.dwa import step_pose
 from planner.fusion import FusionController
-from planner.global_planner import PlanResult
+from planner.global_planner import PlanResult, warm_up
 
 
 @dataclass
@@ -38,6 +38,11 @@ class AgvNode:
         self.name = name
         self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
         self._started = False
+
+    def warm_up(self) -> None:
+        """Load (or compile) every numba kernel this node uses, before the run starts."""
+        warm_up()
+        self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
 
     def on_tick(self, tick: Tick) -> NodeOutput:
         me = next(s for s in tick.agvs if s.name == self.name)

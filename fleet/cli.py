@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fleet import plan_command, run_command
+from fleet import node_commands, plan_command, run_command
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -16,6 +16,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     plan_command.add_parser(sub)
     run_command.add_parsers(sub)
+    node_commands.add_parsers(sub)
     return parser
 
 

@@ -40,8 +40,9 @@ def run_in_process(
                 if out.trajectory:
                     sink(keys.agv_trajectory(name), out.trajectory)
         tick = world.advance(replies)
+        events = world.drain_events()
         if sink:
-            for event in world.events:
+            for event in events:
                 sink(keys.WORLD_EVENT, event)
             if tick is None:
                 sink(keys.WORLD_TICK, world.final_tick())

@@ -6,8 +6,10 @@ import argparse
 import json
 import sys
 
+from bridge.session import BusError
 from fleet.builtin import builtin_scenarios
 from fleet.inprocess import run_in_process
+from fleet.launcher import FleetOptions, run_fleet
 from fleet.progress import Progress
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
 from planner.fusion import VARIANTS
@@ -32,11 +34,35 @@ def add_parsers(sub) -> None:
         metavar="SCENARIO",
         help=f"scenario file or built-in name (default: {DEFAULT_SCENARIO})",
     )
-    p.add_argument("--in-process", action="store_true", help="all nodes in this process, no bus")
+    p.add_argument(
+        "--in-process",
+        action="store_true",
+        help="all nodes in this process with no bus (fast, deterministic)",
+    )
     p.add_argument(
         "--algorithm",
         choices=VARIANTS,
         help="plan every AGV with this variant instead of the scenario's",
+    )
+    p.add_argument(
+        "--realtime",
+        type=positive_float,
+        metavar="F",
+        help="pace the clock at F x real time (default: as fast as possible)",
+    )
+    p.add_argument(
+        "--transport",
+        choices=("unix", "tcp"),
+        default="unix",
+        help="the run's private endpoint: a Unix socket (default) or a free 127.0.0.1 port",
+    )
+    p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
+    p.add_argument(
+        "--tick-timeout",
+        type=positive_float,
+        default=2.0,
+        metavar="S",
+        help="an AGV that does not answer a tick within S seconds is failed (default 2)",
     )
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
@@ -45,6 +71,16 @@ def add_parsers(sub) -> None:
     s = sub.add_parser("scenarios", help="list the built-in scenarios")
     s.add_argument("--json", action="store_true")
     s.set_defaults(handler=list_scenarios)
+
+
+def positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
 
 
 def run(args: argparse.Namespace) -> int:
@@ -56,7 +92,25 @@ def run(args: argparse.Namespace) -> int:
         print(f"agv-fleet run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     progress = None if args.quiet else Progress(scenario)
-    summary = run_in_process(scenario, progress=progress)
+    if args.in_process:
+        if args.realtime:
+            print("agv-fleet run: --realtime needs the bus (drop --in-process)", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        summary = run_in_process(scenario, progress=progress)
+    else:
+        options = FleetOptions(
+            scenario_arg=str(args.scenario),
+            algorithm=args.algorithm,
+            realtime=args.realtime,
+            transport=args.transport,
+            zenoh_config=args.zenoh_config,
+            tick_timeout=args.tick_timeout,
+        )
+        try:
+            summary = run_fleet(scenario, options, progress=progress)
+        except BusError as err:
+            print(f"agv-fleet run: {err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
     if args.json:
         print(json.dumps(summary.to_json()))
     else:

@@ -80,7 +80,6 @@ class World:
 
     def advance(self, replies: dict[str, AgvState]) -> Tick | None:
         """Apply every live AGV's state for tick+1; return that tick, or None at the end."""
-        self.events = []
         self.tick += 1
         self.time = round(self.tick * self.scenario.dt, 9)
         for name in self.live_agvs():
@@ -111,8 +110,16 @@ class World:
         state.status = "failed"
         self._finish(name, "failed", why)
 
+    def drain_events(self) -> list[Event]:
+        """The events since the last call (arrivals, failures, collisions, the end)."""
+        events, self.events = self.events, []
+        return events
+
     def final_tick(self) -> Tick:
-        return self._make_tick()
+        """The end state of the run (after the last ``advance``)."""
+        tick = self._make_tick()
+        tick.final = True
+        return tick
 
     # --- internals ----------------------------------------------------------------
     def _finish(self, name: str, status: str, why: str) -> None:

@@ -1,0 +1,104 @@
+"""Zenoh session configuration for a run: one router, clients that connect to it.
+
+Isolation is by construction: the world's router listens on a fresh per-run
+endpoint (a Unix socket in a new temporary folder by default, or a free
+``tcp/127.0.0.1`` port), multicast and gossip scouting are off, shared memory
+is off (it leaves files in /dev/shm when a process is killed) and every key
+lives under a per-run prefix. A short lease (1 s) makes a dead or hung peer
+visible to liveliness subscribers within about a second.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import tempfile
+import time
+import uuid
+
+import zenoh
+
+LEASE_MS = 1000
+CONNECT_ATTEMPT_MS = 500
+
+
+class BusError(RuntimeError):
+    """The bus could not be opened (bad endpoint or config, no router in time)."""
+
+
+def new_run_id() -> str:
+    return uuid.uuid4().hex[:12]
+
+
+def run_prefix(run_id: str) -> str:
+    return f"agv-fleet/{run_id}"
+
+
+def fresh_endpoint(transport: str = "unix") -> str:
+    """A listen endpoint nobody else uses: a Unix socket in a new temporary
+    folder, or a free TCP port on 127.0.0.1 (``transport="tcp"``)."""
+    if transport == "unix":
+        folder = tempfile.mkdtemp(prefix="agv-fleet-")
+        return f"unixsock-stream/{os.path.join(folder, 'zenoh.sock')}"
+    if transport == "tcp":
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+            s.bind(("127.0.0.1", 0))
+            port = s.getsockname()[1]
+        return f"tcp/127.0.0.1:{port}"
+    raise ValueError(f"unknown transport {transport!r} (unix or tcp)")
+
+
+def _base_config(config_file: str | None) -> zenoh.Config:
+    if not config_file:
+        return zenoh.Config()
+    try:
+        return zenoh.Config.from_file(config_file)
+    except (zenoh.ZError, OSError, ValueError) as err:
+        raise BusError(f"cannot read Zenoh config {config_file}: {err}") from None
+
+
+def _set(config: zenoh.Config, key: str, value) -> None:
+    config.insert_json5(key, json.dumps(value))
+
+
+def make_config(
+    mode: str,
+    *,
+    listen: list[str] = (),
+    connect: list[str] = (),
+    config_file: str | None = None,
+) -> zenoh.Config:
+    """A router or client config; a user's config file (TLS, auth, ...) is the base."""
+    config = _base_config(config_file)
+    _set(config, "mode", mode)
+    _set(config, "listen/endpoints", list(listen))
+    _set(config, "connect/endpoints", list(connect))
+    _set(config, "scouting/multicast/enabled", False)
+    _set(config, "scouting/gossip/enabled", False)
+    _set(config, "transport/shared_memory/enabled", False)
+    _set(config, "transport/link/tx/lease", LEASE_MS)
+    if mode == "client":
+        _set(config, "connect/timeout_ms", CONNECT_ATTEMPT_MS)
+    return config
+
+
+def open_router(listen: str, config_file: str | None = None) -> zenoh.Session:
+    try:
+        return zenoh.open(make_config("router", listen=[listen], config_file=config_file))
+    except zenoh.ZError as err:
+        raise BusError(f"cannot listen on {listen}: {err}") from None
+
+
+def open_client(
+    connect: str, timeout: float = 30.0, config_file: str | None = None
+) -> zenoh.Session:
+    """Connect to the router, retrying until ``timeout`` so start order does not matter."""
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            return zenoh.open(make_config("client", connect=[connect], config_file=config_file))
+        except zenoh.ZError as err:
+            if time.monotonic() >= deadline:
+                raise BusError(f"no router at {connect} after {timeout:g} s: {err}") from None
+            time.sleep(0.05)

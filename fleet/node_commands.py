@@ -1,0 +1,125 @@
+"""``agv-fleet world`` and ``agv-fleet agv``: the parts of a run, started by hand.
+
+For runs across machines: start the world where it should listen, then each
+AGV with ``--connect`` to it (a Zenoh router can join sites). Both must use
+the same scenario and ``--prefix``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from bridge.bus import Bus
+from bridge.session import BusError, open_router
+from fleet.agv_host import serve_agvs
+from fleet.progress import Progress
+from fleet.run_command import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, positive_float
+from fleet.scenario import ScenarioError, load_scenario, with_algorithm
+from fleet.world_process import WorldServer
+from planner.fusion import VARIANTS
+
+
+def _common(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scenario", metavar="SCENARIO", help="scenario file or built-in name")
+    p.add_argument(
+        "--prefix",
+        help="key prefix shared by the run's processes (default: agv-fleet/<scenario name>)",
+    )
+    p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
+    p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
+
+
+def add_parsers(sub) -> None:
+    w = sub.add_parser(
+        "world",
+        help="run only the world, listening for AGV processes",
+        description="Run the world of SCENARIO as a Zenoh router on ENDPOINT.",
+    )
+    _common(w)
+    w.add_argument(
+        "--listen",
+        required=True,
+        metavar="ENDPOINT",
+        help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447",
+    )
+    w.add_argument("--realtime", type=positive_float, metavar="F")
+    w.add_argument("--tick-timeout", type=positive_float, default=2.0, metavar="S")
+    w.add_argument(
+        "--start-timeout",
+        type=positive_float,
+        default=60.0,
+        metavar="S",
+        help="how long to wait for every AGV before tick 0 (default 60)",
+    )
+    w.add_argument("--json", action="store_true")
+    w.add_argument("--quiet", "-q", action="store_true")
+    w.set_defaults(handler=run_world)
+
+    a = sub.add_parser(
+        "agv",
+        help="run one AGV process that connects to a world",
+        description="Run AGV NAME of SCENARIO, connected to the world at ENDPOINT.",
+    )
+    _common(a)
+    a.add_argument(
+        "--name",
+        required=True,
+        action="append",
+        help="the AGV to run; repeat it to run several, one process each",
+    )
+    a.add_argument("--connect", required=True, metavar="ENDPOINT")
+    a.add_argument(
+        "--connect-timeout",
+        type=positive_float,
+        default=30.0,
+        metavar="S",
+        help="give up when no router answers within S seconds (default 30)",
+    )
+    a.set_defaults(handler=run_agv)
+
+
+def _scenario(args):
+    scenario = load_scenario(args.scenario)
+    if args.algorithm:
+        scenario = with_algorithm(scenario, args.algorithm)
+    return scenario, args.prefix or f"agv-fleet/{scenario.name}"
+
+
+def run_world(args: argparse.Namespace) -> int:
+    try:
+        scenario, prefix = _scenario(args)
+        with open_router(args.listen, args.zenoh_config) as session:
+            server = WorldServer(
+                scenario,
+                Bus(session, prefix),
+                tick_timeout=args.tick_timeout,
+                start_timeout=args.start_timeout,
+                realtime=args.realtime,
+                progress=None if args.quiet else Progress(scenario),
+            )
+            summary = server.run()
+    except (ScenarioError, BusError) as err:
+        print(f"agv-fleet world: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(json.dumps(summary.to_json()) if args.json else summary.table())
+    return EXIT_OK if summary.success else EXIT_FAILED
+
+
+def run_agv(args: argparse.Namespace) -> int:
+    try:
+        scenario, prefix = _scenario(args)
+        for name in args.name:
+            scenario.agv(name)
+    except ScenarioError as err:
+        print(f"agv-fleet agv: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return serve_agvs(
+        scenario,
+        args.name,
+        args.connect,
+        prefix,
+        connect_timeout=args.connect_timeout,
+        zenoh_config=args.zenoh_config,
+    )
