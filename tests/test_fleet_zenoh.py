@@ -1,0 +1,222 @@
+"""The fleet over real Zenoh sessions with real processes: determinism, isolation,
+failures (kill -9, SIGSTOP), malformed payloads, and runs started by hand."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from contextlib import contextmanager
+
+import pytest
+
+from bridge import keys
+from bridge.bus import Bus
+from bridge.session import fresh_endpoint, new_run_id, open_client, open_router, run_prefix
+from fleet.inprocess import run_in_process
+from fleet.scenario import load_scenario
+from fleet.world_process import WorldServer
+from tests.processes import agv_pid, fleet_processes
+
+CLI = [sys.executable, "-m", "fleet.cli"]
+STATE_FIELDS = ("x", "y", "theta", "vx", "vy", "omega", "status", "target")
+
+
+def state_key(state):
+    return tuple(getattr(state, f) for f in STATE_FIELDS)
+
+
+@contextmanager
+def hosted_world(scenario_name: str, **server_options):
+    """The world in this process on a fresh bus; the AGVs in real processes."""
+    scenario = load_scenario(scenario_name)
+    endpoint, prefix = fresh_endpoint(), run_prefix(new_run_id())
+    names = [arg for a in scenario.agvs for arg in ("--name", a.name)]
+    host = subprocess.Popen(
+        [*CLI, "agv", scenario_name, *names, "--connect", endpoint, "--prefix", prefix],
+        start_new_session=True,
+    )
+    try:
+        with open_router(endpoint) as session:
+            bus = Bus(session, prefix)
+            yield scenario, bus, WorldServer(scenario, bus, **server_options), endpoint
+    finally:
+        try:
+            host.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            host.terminate()
+            host.wait(timeout=10)
+
+
+def test_zenoh_and_in_process_runs_are_identical_tick_by_tick():
+    """Every AGV's pose, command, status and local target at every tick are the same
+    floats, to the last bit, whether the AGVs are processes on the bus or not."""
+    expected = {}
+    scenario = load_scenario("crossing")
+
+    def sink(key, msg):
+        if key.endswith("/state"):
+            expected[(msg.tick, msg.name)] = state_key(msg)
+
+    reference = run_in_process(scenario, sink=sink)
+    with hosted_world("crossing") as (_, bus, server, _):
+        states = bus.subscribe("agv/*/state")
+        summary = server.run()
+    seen = {}
+    while not states.empty():
+        msg = states.get().msg
+        seen[(msg.tick, msg.name)] = state_key(msg)
+    assert len(scenario.agvs) >= 3
+    assert len(expected) == reference.ticks * len(scenario.agvs)
+    assert seen == expected
+    assert summary.to_json()["agvs"] == reference.to_json()["agvs"]
+
+
+def _variant(tmp_path, name, goal_y):
+    text = load_scenario("corridor").source.replace(
+        "goal = [21.5, 1.5]", f"goal = [21.5, {goal_y}]"
+    )
+    path = tmp_path / f"{name}.toml"
+    path.write_text(text.replace('name = "corridor"', f'name = "{name}"'))
+    return path
+
+
+def test_two_runs_at_once_do_not_see_each_other(tmp_path):
+    # same AGV names and keys, different goals: any cross-talk would change the results
+    paths = [_variant(tmp_path, "corridor-a", 1.5), _variant(tmp_path, "corridor-b", 2.5)]
+    procs = [
+        subprocess.Popen([*CLI, "run", str(p), "--json", "-q"], stdout=subprocess.PIPE, text=True)
+        for p in paths
+    ]
+    outputs = [json.loads(p.communicate(timeout=300)[0]) for p in procs]
+    for path, out in zip(paths, outputs, strict=True):
+        alone = run_in_process(load_scenario(path)).to_json()
+        assert out["agvs"] == alone["agvs"], path.name
+        assert out["ticks"] == alone["ticks"]
+    assert outputs[0]["agvs"] != outputs[1]["agvs"]
+
+
+def _failure_detected_within(sig: int) -> tuple[float, dict]:
+    """Stop or kill AGV 'north' mid-run; seconds until the world marks it failed."""
+    marked = {}
+
+    def progress(world):
+        if world.records["north"].status == "failed" and "north" not in marked:
+            marked["north"] = time.monotonic()
+
+    with hosted_world("crossing", realtime=8.0, progress=progress) as (_, _, server, _):
+        pid = agv_pid("north")
+        result = {}
+        runner = threading.Thread(target=lambda: result.update(summary=server.run()))
+        runner.start()
+        time.sleep(2.0)
+        os.kill(pid, sig)
+        sent = time.monotonic()
+        runner.join(timeout=120)
+        if sig == signal.SIGSTOP:
+            os.kill(pid, signal.SIGKILL)
+    assert not runner.is_alive()
+    return marked["north"] - sent, result["summary"].to_json()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGSTOP], ids=["kill-9", "sigstop"])
+def test_a_dead_or_hung_agv_is_failed_within_2_s_and_the_others_arrive(sig):
+    delay, summary = _failure_detected_within(sig)
+    assert delay < 2.0
+    by_name = {a["name"]: a for a in summary["agvs"]}
+    assert by_name["north"]["status"] == "failed"
+    assert "liveliness" in by_name["north"]["failure"] or "no answer" in by_name["north"]["failure"]
+    for name in ("west", "east", "south"):
+        assert by_name[name]["status"] == "arrived", summary
+    assert summary["sim_time"] <= load_scenario("crossing").time_limit
+
+
+def test_malformed_payloads_are_counted_and_ignored():
+    with hosted_world("corridor", realtime=8.0) as (_, bus, server, endpoint):
+        result = {}
+        runner = threading.Thread(target=lambda: result.update(summary=server.run()))
+        runner.start()
+        time.sleep(1.0)
+        with open_client(endpoint) as session:
+            for payload in (b"not json", b'{"name": "left"}', b"[1, 2]"):
+                session.put(bus.full(keys.agv_state("left")), payload)
+            time.sleep(0.2)
+        runner.join(timeout=120)
+    assert bus.malformed[keys.agv_state("left")] == 3
+    assert result["summary"].success
+    alone = run_in_process(load_scenario("corridor")).to_json()
+    assert result["summary"].to_json()["agvs"] == alone["agvs"]
+
+
+def test_kill_9_of_an_agv_under_the_launcher():
+    proc = subprocess.Popen(
+        [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8"],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    pid = agv_pid("north")
+    time.sleep(2.0)  # mid-run: the crossing takes ~44 s simulated, ~5.5 s at 8x
+    os.kill(pid, signal.SIGKILL)
+    out, _ = proc.communicate(timeout=300)
+    assert proc.returncode == 1
+    statuses = {a["name"]: a["status"] for a in json.loads(out)["agvs"]}
+    assert statuses == {"west": "arrived", "east": "arrived", "south": "arrived", "north": "failed"}
+
+
+def test_ctrl_c_ends_the_run_and_every_process():
+    proc = subprocess.Popen(
+        [*CLI, "run", "warehouse", "--realtime", "1", "-q"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    agv_pid("agv8")
+    children = set(fleet_processes()) - {proc.pid}
+    assert len(children) >= 9  # the host and its 8 AGV processes
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130
+    assert "Traceback" not in err
+    time.sleep(0.5)
+    assert not children & set(fleet_processes())
+
+
+def test_world_and_agvs_started_by_hand_over_tcp():
+    port_endpoint = fresh_endpoint("tcp")
+    prefix = f"test/{new_run_id()}"
+    common = ["--prefix", prefix]
+    # the AGVs first: they retry until the world listens
+    agvs = [
+        subprocess.Popen(
+            [*CLI, "agv", "corridor", "--name", n, "--connect", port_endpoint, *common]
+        )
+        for n in ("left", "right")
+    ]
+    time.sleep(0.5)
+    world = subprocess.run(
+        [*CLI, "world", "corridor", "--listen", port_endpoint, "--json", "-q", *common],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    for agv in agvs:
+        assert agv.wait(timeout=30) == 0
+    assert world.returncode == 0, world.stderr
+    alone = run_in_process(load_scenario("corridor")).to_json()
+    assert json.loads(world.stdout)["agvs"] == alone["agvs"]
+
+
+def test_an_agv_with_no_world_gives_up_with_one_line():
+    proc = subprocess.run(
+        [*CLI, "agv", "corridor", "--name", "left", "--connect", fresh_endpoint(),
+         "--connect-timeout", "1"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "no router" in proc.stderr
