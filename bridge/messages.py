@@ -119,7 +119,34 @@ class MessageError(ValueError):
 
 
 def to_dict(msg) -> dict:
-    return dataclasses.asdict(msg)
+    """The message as plain JSON-ready data (``dataclasses.asdict`` deep-copies
+    every value and made encoding a 50-AGV tick cost 0.5 ms)."""
+    return _encoder(type(msg))(msg)
+
+
+@functools.cache
+def _encoder(cls):
+    hints = typing.get_type_hints(cls)
+    plan = [(f.name, _field_encoder(hints[f.name])) for f in dataclasses.fields(cls)]
+    return lambda msg: {
+        name: value if encode is None or value is None else encode(value)
+        for name, encode in plan
+        for value in (getattr(msg, name),)
+    }
+
+
+def _field_encoder(hint):
+    """None where the value is JSON-ready as it is, else a function that makes it so."""
+    origin = typing.get_origin(hint)
+    if origin in (typing.Union, types.UnionType):
+        (inner,) = [a for a in typing.get_args(hint) if a is not type(None)]
+        return _field_encoder(inner)
+    if origin is list:
+        inner = _field_encoder(typing.get_args(hint)[0])
+        return None if inner is None else (lambda items: [inner(x) for x in items])
+    if dataclasses.is_dataclass(hint):
+        return _encoder(hint)
+    return None
 
 
 def from_dict(cls, data):

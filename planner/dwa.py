@@ -235,6 +235,29 @@ def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius):
     return out
 
 
+_NO_DISCS = np.zeros((0, 5))
+
+
+def relevant_discs(
+    config: DwaConfig, pose: Pose, xs: np.ndarray, ys: np.ndarray, discs: np.ndarray, bound: float
+) -> np.ndarray:
+    """The discs that can lower some trajectory's clearance below ``bound``.
+
+    ``bound`` is the largest static clearance over the samples: a disc that
+    cannot come closer than that to any trajectory point within the horizon
+    (its distance now, less how far the AGV and the disc can travel) changes
+    no sample's minimum clearance, so dropping it changes nothing. With many
+    AGVs on a map most discs are such, and the clearance kernel's cost is
+    linear in the number of discs.
+    """
+    if not len(discs):
+        return discs
+    agv_reach = math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
+    disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * (config.steps * config.dt)
+    gap_now = np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
+    return np.ascontiguousarray(discs[gap_now - agv_reach - disc_reach < bound])
+
+
 def admissible_mask(config: DwaConfig, commands: np.ndarray, clearance: np.ndarray) -> np.ndarray:
     """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance."""
     room = np.maximum(clearance, 0.0)
@@ -316,8 +339,13 @@ class DwaPlanner:
         commands = dynamic_window(cfg, command)
         xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps)
         clearance = min_clearance(
-            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+            xs, ys, field.samples, 1.0 / field.spacing, _NO_DISCS, cfg.dt, cfg.radius
         )
+        discs = relevant_discs(cfg, pose, xs, ys, discs, float(clearance.max()))
+        if len(discs):
+            clearance = min_clearance(
+                xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+            )
         mask = admissible_mask(cfg, commands, clearance)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
