@@ -9,7 +9,11 @@ MAP_SUFFIXES = (".txt", ".map", ".yaml", ".yml")
 
 
 def _data_dir() -> Path:
-    return Path(str(resources.files("fleet.builtin_scenarios")))
+    """The installed data package, or the repository's scenarios/ in a plain checkout."""
+    try:
+        return Path(str(resources.files("fleet.builtin_scenarios")))
+    except ModuleNotFoundError:
+        return Path(__file__).resolve().parents[1] / "scenarios"
 
 
 def bundled_maps() -> dict[str, Path]:

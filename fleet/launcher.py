@@ -40,7 +40,8 @@ class FleetOptions:
 
 def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: str) -> list[str]:
     """One host process that forks a process per AGV (see fleet.agv_host)."""
-    cmd = [sys.executable, "-m", "fleet.cli", "agv", options.scenario_arg]
+    # -P: import the same installed packages as this process, not a checkout in the cwd
+    cmd = [sys.executable, "-P", "-m", "fleet.cli", "agv", options.scenario_arg]
     for name in names:
         cmd += ["--name", name]
     cmd += ["--connect", endpoint, "--prefix", prefix]
@@ -76,11 +77,22 @@ def run_fleet(
                     tick_timeout=options.tick_timeout,
                     realtime=options.realtime,
                     progress=progress,
+                    abort_check=lambda: _exited_early(children),
                 )
                 return server.run()
         finally:
             if endpoint.startswith("unixsock-stream/"):
                 shutil.rmtree(os.path.dirname(endpoint.split("/", 1)[1]), ignore_errors=True)
+
+
+def _exited_early(children: list[subprocess.Popen]) -> str | None:
+    """Why the run cannot start: a child process that already ended with an error."""
+    for child in children:
+        code = child.poll()
+        if code:
+            what = " ".join(child.args[4:6])
+            return f"the process of '{what}' ended with status {code} before the run started"
+    return None
 
 
 def _spawn(cmd: list[str]) -> subprocess.Popen:

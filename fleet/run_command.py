@@ -12,6 +12,7 @@ from fleet.inprocess import run_in_process
 from fleet.launcher import FleetOptions, run_fleet
 from fleet.progress import Progress
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
+from fleet.world_process import FleetStartError
 from planner.fusion import VARIANTS
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -108,7 +109,7 @@ def run(args: argparse.Namespace) -> int:
         )
         try:
             summary = run_fleet(scenario, options, progress=progress)
-        except BusError as err:
+        except (BusError, FleetStartError) as err:
             print(f"agv-fleet run: {err}", file=sys.stderr)
             return EXIT_BAD_INPUT
     if args.json:

@@ -22,6 +22,10 @@ from fleet.world import World, map_message
 POLL_S = 0.02
 
 
+class FleetStartError(RuntimeError):
+    """The run cannot start: the AGV processes failed before tick 0."""
+
+
 class WorldServer:
     def __init__(
         self,
@@ -32,6 +36,7 @@ class WorldServer:
         start_timeout: float = 30.0,
         realtime: float | None = None,
         progress: Callable[[World], None] | None = None,
+        abort_check: Callable[[], str | None] | None = None,
     ):
         self.scenario = scenario
         self.bus = bus
@@ -39,6 +44,7 @@ class WorldServer:
         self.start_timeout = start_timeout
         self.realtime = realtime
         self.progress = progress
+        self.abort_check = abort_check
         self.world = World(scenario)
         self.alive: set[str] = set()
         self._states = bus.subscribe("agv/*/state")
@@ -73,6 +79,9 @@ class WorldServer:
         deadline = time.monotonic() + self.start_timeout
         while not names <= self.alive and time.monotonic() < deadline:
             self._update_liveliness(timeout=POLL_S)
+            problem = self.abort_check() if self.abort_check else None
+            if problem:
+                raise FleetStartError(problem)
         for name in sorted(names - self.alive):
             self.world.mark_failed(name, f"did not come up within {self.start_timeout:g} s")
 

@@ -1,0 +1,62 @@
+"""``agv-fleet replay``: show a recording in Rerun (native viewer, an .rrd file, the web viewer)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from bridge.messages import MessageError
+from fleet.run_command import positive_float
+from recordings.reader import RecordingError, open_recording
+from recordings.rerun_view import RerunError, require_display, save_rrd, serve_web, spawn_viewer
+
+EXIT_OK, EXIT_BAD_INPUT = 0, 2
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "replay",
+        help="show a recording in Rerun",
+        description=(
+            "Show a recording in the Rerun viewer (needs a display), write it to an .rrd "
+            "file (--save) or serve the web viewer on 127.0.0.1 (--web). Exit 2 for a "
+            "recording that cannot be read or nowhere to show it."
+        ),
+    )
+    p.add_argument("recording", metavar="REC.mcap", help="a recording of agv-fleet run")
+    p.add_argument("--save", metavar="OUT.rrd", help="write a Rerun file (open: rerun OUT.rrd)")
+    p.add_argument("--web", action="store_true", help="serve the web viewer until Ctrl-C")
+    p.add_argument(
+        "--rate",
+        type=positive_float,
+        metavar="F",
+        help="play at F x real time into the viewer or web viewer (default: all at once)",
+    )
+    p.set_defaults(handler=replay)
+
+
+def replay(args: argparse.Namespace) -> int:
+    viewer = not (args.save or args.web)
+    try:
+        if args.rate and not (viewer or args.web):
+            raise RerunError("--rate paces the viewer or --web, not --save")
+        if viewer:
+            require_display()  # before reading what could not be shown
+        recording = open_recording(args.recording)
+        if recording.truncated:
+            print(
+                f"agv-fleet replay: {args.recording} is cut short ({recording.recovered_note}); "
+                "replaying what was recovered",
+                file=sys.stderr,
+            )
+        if args.save:
+            save_rrd(recording, args.save)
+            print(f"agv-fleet replay: wrote {args.save}", file=sys.stderr)
+        if args.web:
+            serve_web(recording, rate=args.rate)
+        elif viewer:
+            spawn_viewer(recording, rate=args.rate)
+    except (RecordingError, RerunError, MessageError) as err:
+        print(f"agv-fleet replay: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return EXIT_OK
