@@ -7,11 +7,12 @@ a key carries, so the recorder and the replay need no other table.
 
 from __future__ import annotations
 
-from bridge.messages import AgvState, Event, MapMsg, PlanMsg, Tick, TrajectoryMsg
+from bridge.messages import AgvState, Event, MapMsg, PlanMsg, ResultMsg, Tick, TrajectoryMsg
 
 WORLD_TICK = "world/tick"
 WORLD_MAP = "world/map"
 WORLD_EVENT = "world/event"
+WORLD_RESULT = "world/result"
 ALIVE = "alive"
 
 
@@ -35,6 +36,10 @@ def alive_agv(name: str) -> str:
     return f"{ALIVE}/agv/{name}"
 
 
+def alive_recorder() -> str:
+    return f"{ALIVE}/recorder"
+
+
 def message_type(key: str):
     """The message class a relative key carries, or None for keys that carry none."""
     if key == WORLD_TICK:
@@ -43,6 +48,8 @@ def message_type(key: str):
         return MapMsg
     if key == WORLD_EVENT:
         return Event
+    if key == WORLD_RESULT:
+        return ResultMsg
     parts = key.split("/")
     if len(parts) == 3 and parts[0] == "agv":
         return {"state": AgvState, "plan": PlanMsg, "trajectory": TrajectoryMsg}.get(parts[2])

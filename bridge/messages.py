@@ -111,7 +111,14 @@ class Event:
     detail: str = ""
 
 
-MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event)
+@dataclass
+class ResultMsg:
+    """How the run ended: the run summary as JSON text (its shape is the CLI's --json)."""
+
+    summary: str
+
+
+MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event, ResultMsg)
 
 
 class MessageError(ValueError):

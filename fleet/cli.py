@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fleet import node_commands, plan_command, run_command
+from fleet import node_commands, plan_command, record_commands, replay_command, run_command
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -17,6 +17,8 @@ def build_parser() -> argparse.ArgumentParser:
     plan_command.add_parser(sub)
     run_command.add_parsers(sub)
     node_commands.add_parsers(sub)
+    record_commands.add_parsers(sub)
+    replay_command.add_parsers(sub)
     return parser
 
 

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable
 
 from bridge import keys
+from bridge.messages import ResultMsg
 from fleet.agv_node import AgvNode
 from fleet.scenario import Scenario
 from fleet.summary import RunSummary, summarize
@@ -48,4 +50,7 @@ def run_in_process(
                 sink(keys.WORLD_TICK, world.final_tick())
         if progress:
             progress(world)
-    return summarize(world, time.perf_counter() - t0)
+    summary = summarize(world, time.perf_counter() - t0)
+    if sink:
+        sink(keys.WORLD_RESULT, ResultMsg(json.dumps(summary.to_json())))
+    return summary

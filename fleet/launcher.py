@@ -17,6 +17,7 @@ import time
 from collections.abc import Callable
 from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
 
 from bridge.bus import Bus
 from bridge.session import fresh_endpoint, new_run_id, open_router, run_prefix
@@ -36,6 +37,7 @@ class FleetOptions:
     transport: str = "unix"
     zenoh_config: str | None = None
     tick_timeout: float = 2.0
+    record_path: Path | None = None  # None: no recorder
 
 
 def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: str) -> list[str]:
@@ -52,14 +54,26 @@ def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: 
     return cmd
 
 
+def recorder_command(options: FleetOptions, endpoint: str, prefix: str, run_id: str) -> list[str]:
+    cmd = [sys.executable, "-P", "-m", "fleet.cli", "record", options.scenario_arg]
+    cmd += ["--connect", endpoint, "--prefix", prefix, "--run-id", run_id]
+    cmd += ["-o", str(options.record_path)]
+    if options.algorithm:
+        cmd += ["--algorithm", options.algorithm]
+    if options.zenoh_config:
+        cmd += ["--zenoh-config", options.zenoh_config]
+    return cmd
+
+
 def run_fleet(
     scenario: Scenario,
     options: FleetOptions,
     progress: Callable[[World], None] | None = None,
-    extra_children: Callable[[str, str], list[list[str]]] | None = None,
+    tap: Callable[[str, object], None] | None = None,
 ) -> RunSummary:
-    """Run ``scenario`` with one process per AGV; ``extra_children(endpoint, prefix)``
-    gives more commands to start on the same bus (the recorder)."""
+    """Run ``scenario`` with one process per AGV (and a recorder process when
+    ``options.record_path`` is set), all on a fresh private bus. ``tap(key, msg)``
+    sees every message of the bus, in this thread, after each tick (the live view)."""
     run_id = new_run_id()
     prefix = run_prefix(run_id)
     endpoint = fresh_endpoint(options.transport)
@@ -68,21 +82,42 @@ def run_fleet(
         try:
             names = [agv.name for agv in scenario.agvs]
             children.append(_spawn(agv_command(options, names, endpoint, prefix)))
-            for cmd in extra_children(endpoint, prefix) if extra_children else []:
-                children.append(_spawn(cmd))
+            if options.record_path:
+                children.append(_spawn(recorder_command(options, endpoint, prefix, run_id)))
             with open_router(endpoint, options.zenoh_config) as session:
+                bus = Bus(session, prefix)
+                if tap:
+                    progress = _tapped(bus, tap, progress)
                 server = WorldServer(
                     scenario,
-                    Bus(session, prefix),
+                    bus,
                     tick_timeout=options.tick_timeout,
                     realtime=options.realtime,
                     progress=progress,
                     abort_check=lambda: _exited_early(children),
+                    recorder=options.record_path is not None,
                 )
-                return server.run()
+                summary = server.run()
+                if progress:
+                    progress(server.world)  # the last messages, for the tap
+                return summary
         finally:
             if endpoint.startswith("unixsock-stream/"):
                 shutil.rmtree(os.path.dirname(endpoint.split("/", 1)[1]), ignore_errors=True)
+
+
+def _tapped(bus: Bus, tap, progress):
+    """A progress callback that also hands every message seen on the bus to ``tap``."""
+    messages = bus.subscribe("**")
+
+    def on_tick(world: World) -> None:
+        while not messages.empty():
+            received = messages.get_nowait()
+            tap(received.key, received.msg)
+        if progress:
+            progress(world)
+
+    return on_tick
 
 
 def _exited_early(children: list[subprocess.Popen]) -> str | None:
@@ -90,7 +125,7 @@ def _exited_early(children: list[subprocess.Popen]) -> str | None:
     for child in children:
         code = child.poll()
         if code:
-            what = " ".join(child.args[4:6])
+            what = " ".join(child.args[4:6])  # the command and the scenario
             return f"the process of '{what}' ended with status {code} before the run started"
     return None
 

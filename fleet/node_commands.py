@@ -10,15 +10,18 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import BusError, open_router
+from bridge.session import BusError, open_client, open_router
 from fleet.agv_host import serve_agvs
 from fleet.progress import Progress
+from fleet.recorder_process import serve_recorder
 from fleet.run_command import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, positive_float
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
 from fleet.world_process import WorldServer
 from planner.fusion import VARIANTS
+from recordings.writer import RecordingWriter, default_recording_path
 
 
 def _common(p: argparse.ArgumentParser) -> None:
@@ -79,6 +82,21 @@ def add_parsers(sub) -> None:
     )
     a.set_defaults(handler=run_agv)
 
+    r = sub.add_parser(
+        "record",
+        help="record a run's bus into an MCAP file",
+        description=(
+            "Connect to the world at ENDPOINT and record every message of the run into "
+            "an MCAP file until the world ends."
+        ),
+    )
+    _common(r)
+    r.add_argument("--connect", required=True, metavar="ENDPOINT")
+    r.add_argument("-o", "--output", metavar="PATH", help="default: runs/<scenario>-<UTC>.mcap")
+    r.add_argument("--run-id", help="stored in the recording's run facts")
+    r.add_argument("--connect-timeout", type=positive_float, default=30.0, metavar="S")
+    r.set_defaults(handler=run_record)
+
 
 def _scenario(args):
     scenario = load_scenario(args.scenario)
@@ -123,3 +141,25 @@ def run_agv(args: argparse.Namespace) -> int:
         connect_timeout=args.connect_timeout,
         zenoh_config=args.zenoh_config,
     )
+
+
+def run_record(args: argparse.Namespace) -> int:
+    try:
+        scenario, prefix = _scenario(args)
+        path = Path(args.output) if args.output else default_recording_path(scenario.name)
+        facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
+        if args.run_id:
+            facts["run_id"] = args.run_id
+        with (
+            open_client(args.connect, args.connect_timeout, args.zenoh_config) as session,
+            RecordingWriter(
+                path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
+            ) as writer,
+        ):
+            serve_recorder(Bus(session, prefix), writer, scenario.dt)
+    except (ScenarioError, BusError, OSError) as err:
+        print(f"agv-fleet record: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        return 130
+    return EXIT_OK

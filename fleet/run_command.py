@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from contextlib import ExitStack
+from pathlib import Path
 
 from bridge.session import BusError
 from fleet.builtin import builtin_scenarios
@@ -14,6 +16,8 @@ from fleet.progress import Progress
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
 from fleet.world_process import FleetStartError
 from planner.fusion import VARIANTS
+from recordings.rerun_view import LiveView, RerunError
+from recordings.writer import RecordingWriter, default_recording_path, record_sink
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 DEFAULT_SCENARIO = "warehouse"
@@ -65,6 +69,24 @@ def add_parsers(sub) -> None:
         metavar="S",
         help="an AGV that does not answer a tick within S seconds is failed (default 2)",
     )
+    p.add_argument(
+        "-o",
+        "--output",
+        metavar="PATH",
+        help="where to record the run (default: runs/<scenario>-<UTC time>.mcap)",
+    )
+    p.add_argument("--no-record", action="store_true", help="do not record the run")
+    p.add_argument(
+        "--rerun",
+        action="store_true",
+        help="show the run live in Rerun (a viewer window, or --rerun-save / --rerun-web)",
+    )
+    p.add_argument("--rerun-save", metavar="OUT.rrd", help="with --rerun: also write an .rrd")
+    p.add_argument(
+        "--rerun-web",
+        action="store_true",
+        help="with --rerun: serve the web viewer on 127.0.0.1 (kept up after the run until Ctrl-C)",
+    )
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
@@ -92,31 +114,74 @@ def run(args: argparse.Namespace) -> int:
     except ScenarioError as err:
         print(f"agv-fleet run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
+    if args.in_process and args.realtime:
+        print("agv-fleet run: --realtime needs the bus (drop --in-process)", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    record_path = None
+    if not args.no_record:
+        record_path = Path(args.output) if args.output else default_recording_path(scenario.name)
+    if (args.rerun_save or args.rerun_web) and not args.rerun:
+        print("agv-fleet run: --rerun-save and --rerun-web go with --rerun", file=sys.stderr)
+        return EXIT_BAD_INPUT
     progress = None if args.quiet else Progress(scenario)
-    if args.in_process:
-        if args.realtime:
-            print("agv-fleet run: --realtime needs the bus (drop --in-process)", file=sys.stderr)
-            return EXIT_BAD_INPUT
-        summary = run_in_process(scenario, progress=progress)
-    else:
-        options = FleetOptions(
-            scenario_arg=str(args.scenario),
-            algorithm=args.algorithm,
-            realtime=args.realtime,
-            transport=args.transport,
-            zenoh_config=args.zenoh_config,
-            tick_timeout=args.tick_timeout,
-        )
+    with ExitStack() as stack:
         try:
-            summary = run_fleet(scenario, options, progress=progress)
-        except (BusError, FleetStartError) as err:
+            view = None
+            if args.rerun:
+                view = stack.enter_context(
+                    LiveView(scenario.dt, save=args.rerun_save, web=args.rerun_web)
+                )
+            summary = _run(args, scenario, record_path, progress, view)
+        except RerunError as err:  # its hints name replay's flags: say run's
+            hint = str(err).replace("--save", "--rerun-save").replace("--web", "--rerun-web")
+            print(f"agv-fleet run: {hint}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        except (BusError, FleetStartError, OSError) as err:
             print(f"agv-fleet run: {err}", file=sys.stderr)
             return EXIT_BAD_INPUT
-    if args.json:
-        print(json.dumps(summary.to_json()))
-    else:
-        print(summary.table())
+        if record_path:
+            print(f"recorded to {record_path}", file=sys.stderr)
+        print(json.dumps(summary.to_json()) if args.json else summary.table(), flush=True)
+        if view is not None and args.rerun_web:
+            view.hold()
     return EXIT_OK if summary.success else EXIT_FAILED
+
+
+def _run(args, scenario, record_path, progress, view):
+    if args.in_process:
+        return _run_in_process(scenario, record_path, args.algorithm, progress, view)
+    options = FleetOptions(
+        scenario_arg=str(args.scenario),
+        algorithm=args.algorithm,
+        realtime=args.realtime,
+        transport=args.transport,
+        zenoh_config=args.zenoh_config,
+        tick_timeout=args.tick_timeout,
+        record_path=record_path,
+    )
+    return run_fleet(scenario, options, progress=progress, tap=view)
+
+
+def _run_in_process(scenario, record_path, algorithm, progress, view):
+    if record_path is None:
+        return run_in_process(scenario, view, progress)
+    facts = {"mode": "in-process", "algorithm": algorithm or "scenario's"}
+    with RecordingWriter(
+        record_path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
+    ) as writer:
+        record = record_sink(writer, scenario.dt)
+        sink = record if view is None else _both(record, view)
+        summary = run_in_process(scenario, sink, progress)
+        writer.finish(summary.to_json())
+    return summary
+
+
+def _both(first, second):
+    def sink(key, msg):
+        first(key, msg)
+        second(key, msg)
+
+    return sink
 
 
 def list_scenarios(args: argparse.Namespace) -> int:

@@ -9,12 +9,15 @@ stopped obstacle at its last pose; the others go on.
 
 from __future__ import annotations
 
+import contextlib
+import json
 import queue
 import time
 from collections.abc import Callable
 
 from bridge import keys
 from bridge.bus import Bus
+from bridge.messages import ResultMsg
 from fleet.scenario import Scenario
 from fleet.summary import RunSummary, summarize
 from fleet.world import World, map_message
@@ -37,6 +40,7 @@ class WorldServer:
         realtime: float | None = None,
         progress: Callable[[World], None] | None = None,
         abort_check: Callable[[], str | None] | None = None,
+        recorder: bool = False,
     ):
         self.scenario = scenario
         self.bus = bus
@@ -49,6 +53,7 @@ class WorldServer:
         self.alive: set[str] = set()
         self._states = bus.subscribe("agv/*/state")
         self._liveliness = bus.watch_alive(f"{keys.ALIVE}/agv/*")
+        self._recorder = bus.watch_alive(keys.alive_recorder()) if recorder else None
 
     def run(self) -> RunSummary:
         t0 = time.perf_counter()
@@ -71,17 +76,26 @@ class WorldServer:
                 if delay > 0:
                     time.sleep(delay)
         self.bus.publish(keys.WORLD_TICK, world.final_tick())
-        return summarize(world, time.perf_counter() - t0)
+        summary = summarize(world, time.perf_counter() - t0)
+        self.bus.publish(keys.WORLD_RESULT, ResultMsg(json.dumps(summary.to_json())))
+        return summary
 
     def _wait_for_agvs(self) -> None:
-        """Every AGV's token before tick 0 (it is declared after its tick subscriber)."""
+        """Every AGV's token before tick 0 (it is declared after its tick subscriber),
+        and the recorder's, if one is expected, so that it misses nothing."""
         names = {a.name for a in self.scenario.agvs}
         deadline = time.monotonic() + self.start_timeout
-        while not names <= self.alive and time.monotonic() < deadline:
+        recorder_up = self._recorder is None
+        while not (recorder_up and names <= self.alive) and time.monotonic() < deadline:
             self._update_liveliness(timeout=POLL_S)
+            if not recorder_up:
+                with contextlib.suppress(queue.Empty):
+                    recorder_up = self._recorder.get_nowait()[1]
             problem = self.abort_check() if self.abort_check else None
             if problem:
                 raise FleetStartError(problem)
+        if not recorder_up:
+            raise FleetStartError(f"the recorder did not come up within {self.start_timeout:g} s")
         for name in sorted(names - self.alive):
             self.world.mark_failed(name, f"did not come up within {self.start_timeout:g} s")
 

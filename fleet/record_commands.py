@@ -1,0 +1,103 @@
+"""``agv-fleet info`` and ``agv-fleet analyze``: recordings, described and measured.
+
+Bad input (a missing file, not MCAP, not an agv-fleet recording) is one line on
+stderr and exit 2. A truncated recording is recovered: a note on stderr, the
+output as usual, exit 0.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from recordings.analysis import analyze
+from recordings.info import describe, describe_json
+from recordings.reader import Recording, RecordingError, open_recording
+from recordings.report import comparison_table, run_table, to_csv, to_json
+from recordings.series import SeriesError, extract
+
+EXIT_OK, EXIT_BAD_INPUT = 0, 2
+
+
+def add_parsers(sub) -> None:
+    info = sub.add_parser(
+        "info",
+        help="what a recording holds (like ros2 bag info)",
+        description="Describe a recording: size, duration, channels, AGVs, how the run ended.",
+    )
+    info.add_argument("recording", metavar="REC.mcap")
+    info.add_argument("--json", action="store_true", help="print one JSON object")
+    info.set_defaults(handler=run_info)
+
+    analyze_parser = sub.add_parser(
+        "analyze",
+        help="run time, path, smoothness, clearance per AGV; compare recordings",
+        description=(
+            "Measure recordings per AGV and per run; with several recordings, compare "
+            "them side by side with the %% difference to the first."
+        ),
+    )
+    analyze_parser.add_argument("recordings", nargs="+", metavar="REC.mcap")
+    output = analyze_parser.add_mutually_exclusive_group()
+    output.add_argument("--json", action="store_true", help="print one JSON object")
+    output.add_argument("--csv", action="store_true", help="print one CSV row per AGV")
+    analyze_parser.add_argument(
+        "--plots", metavar="DIR", type=Path, help="write PNG plots (map, v(t) and ω(t)) into DIR"
+    )
+    analyze_parser.set_defaults(handler=run_analyze)
+
+
+def _open(path: str, command: str) -> Recording:
+    rec = open_recording(path)
+    if rec.truncated:
+        print(f"agv-fleet {command}: {path} is truncated: {rec.recovered_note}", file=sys.stderr)
+    return rec
+
+
+def run_info(args: argparse.Namespace) -> int:
+    try:
+        rec = _open(args.recording, "info")
+    except RecordingError as err:
+        print(f"agv-fleet info: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(json.dumps(describe_json(rec)) if args.json else describe(rec))
+    return EXIT_OK
+
+
+def run_analyze(args: argparse.Namespace) -> int:
+    runs = []
+    for path in args.recordings:
+        try:
+            rec = _open(path, "analyze")
+            series = extract(rec)
+        except (RecordingError, SeriesError) as err:
+            print(f"agv-fleet analyze: {err}", file=sys.stderr)
+            return EXIT_BAD_INPUT
+        runs.append(analyze(rec, series))
+        if rec.undecodable:
+            print(
+                f"agv-fleet analyze: {path}: skipped {rec.undecodable} undecodable messages",
+                file=sys.stderr,
+            )
+        if args.plots:
+            # imported here: matplotlib takes ~0.2 s to load, and every agv-fleet process
+            # (the world, each AGV) imports this module through the CLI
+            from recordings.plots import save_plots
+
+            try:
+                written = save_plots(series, args.plots, Path(path).stem)
+            except OSError as err:
+                print(f"agv-fleet analyze: cannot write plots: {err}", file=sys.stderr)
+                return EXIT_BAD_INPUT
+            print(f"agv-fleet analyze: {len(written)} plots in {args.plots}", file=sys.stderr)
+    if args.json:
+        print(json.dumps(to_json(runs)))
+    elif args.csv:
+        sys.stdout.write(to_csv(runs))
+    else:
+        print("\n\n".join(run_table(r) for r in runs))
+        if len(runs) > 1:
+            print("\n" + comparison_table(runs))
+    return EXIT_OK

@@ -1,0 +1,61 @@
+"""The recorder tap: every message of a run's bus, as it came, into one MCAP file.
+
+It subscribes to everything under the run prefix before tick 0 (the world
+waits for its liveliness token), stores payloads without re-encoding them at
+their simulated time, and ends when the world's token goes: it then writes
+the run's result (from ``world/result``) and the footer. If it is killed, the
+completed chunks stay readable (see recordings.writer).
+"""
+
+from __future__ import annotations
+
+import json
+import queue
+
+from bridge import keys
+from bridge.bus import Bus
+from recordings.writer import RecordingWriter
+
+POLL_S = 0.1
+
+
+def serve_recorder(bus: Bus, writer: RecordingWriter, dt: float) -> int:
+    """Record until the world is gone; returns the number of messages recorded."""
+    dt_ns = round(dt * 1e9)
+    messages = bus.subscribe("**", decoded=False)
+    world = bus.watch_alive(keys.alive_world())
+    bus.declare_alive(keys.alive_recorder())
+    result = None
+    world_seen = world_gone = False
+    count = 0
+    while True:
+        try:
+            while True:
+                _, alive = world.get_nowait()
+                world_seen |= alive
+                world_gone |= world_seen and not alive
+        except queue.Empty:
+            pass
+        try:
+            received = messages.get(timeout=POLL_S)
+        except queue.Empty:
+            writer.flush_if_due()
+            if world_gone:  # nothing more in flight: the world closed its session
+                break
+            continue
+        try:
+            data = json.loads(received.payload)
+        except ValueError:
+            data = None  # recorded as it came; readers count it as undecodable
+        tick = data.get("tick", 0) if isinstance(data, dict) else 0
+        writer.write_payload(
+            received.key, received.payload, int(tick) * dt_ns if isinstance(tick, int) else 0
+        )
+        count += 1
+        if received.key == keys.WORLD_RESULT and isinstance(data, dict):
+            result = json.loads(data.get("summary", "{}"))
+    if result is not None:
+        writer.finish(result)
+    else:
+        writer.close()
+    return count

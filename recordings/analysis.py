@@ -1,0 +1,334 @@
+"""Offline analysis of a recording: per AGV and per run, and runs compared.
+
+Definitions (all from ``recordings.series``, i.e. the world's ticks):
+
+- run time: the sim time of the run's last tick; arrival: the time of the
+  first tick an AGV reports ``arrived``.
+- distance travelled: the sum of |Δposition| over every tick of the run.
+- path: the first plan that found a path; its key nodes measured with
+  ``planner.path_metrics`` (length, turning times, total turning angle);
+  replans: plans made for the reason ``replan``.
+- smoothness, over the drive (tick 0 up to the tick the AGV arrived or failed;
+  parked time would dilute it): the world-frame velocity vector of each
+  state is its body-frame command turned by the heading it was applied at,
+  theta - omega*dt (Eq. 4 turns the command by the heading before the
+  step); acceleration and jerk are finite differences over dt, reported as
+  RMS of their norms; the same for the speed |v|. Angular: mean |Δω| per tick
+  and the number of sign changes of ω (exact zeros skipped).
+- clearance, over every tick: to obstacles (map, temporary cells shown at
+  that tick, moving obstacles) and to other AGVs, separately; surface to
+  surface, as the world measures it (<= 0 is a contact).
+- collisions: ``collision`` events; planning time: ``plan_time_ms`` of each
+  control cycle of the drive (mean, 95th percentile).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from planner import path_metrics
+from planner.distance_field import DistanceField
+from recordings.reader import Recording
+from recordings.series import RunSeries, extract
+
+DONE = ("arrived", "failed")
+
+
+@dataclass(frozen=True)
+class AgvAnalysis:
+    name: str
+    status: str
+    arrival_time: float | None  # s
+    distance: float  # m
+    path_length: float | None  # m, first plan's key nodes
+    turns: int | None
+    turning_angle_deg: float | None
+    replans: int
+    rms_accel: float | None  # m/s², world-frame velocity vector
+    rms_jerk: float | None  # m/s³
+    rms_speed_accel: float | None  # m/s², of |v|
+    rms_speed_jerk: float | None  # m/s³
+    mean_abs_domega: float | None  # rad/s per tick
+    omega_sign_changes: int
+    min_clearance_obstacles: float | None  # m
+    min_clearance_agvs: float | None  # m
+    collisions: int
+    plan_time_mean_ms: float | None
+    plan_time_p95_ms: float | None
+
+
+@dataclass(frozen=True)
+class RunAnalysis:
+    path: str
+    scenario: str
+    run_id: str
+    finished: bool  # the recording has the run's result
+    truncated: bool
+    dt: float | None
+    ticks: int
+    run_time: float  # s
+    arrived: int
+    collisions: int
+    path_length: float | None  # mean over AGVs, as are the next six
+    distance: float | None
+    turns: float | None
+    turning_angle_deg: float | None
+    rms_accel: float | None
+    rms_jerk: float | None
+    mean_abs_domega: float | None
+    omega_sign_changes: float | None
+    min_clearance_obstacles: float | None  # min over AGVs
+    min_clearance_agvs: float | None
+    replans: int
+    plan_time_mean_ms: float | None  # over every control cycle of every AGV
+    plan_time_p95_ms: float | None
+    agvs: tuple[AgvAnalysis, ...]
+
+    def to_json(self) -> dict:
+        return json_ready(asdict(self))
+
+
+def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
+    """Analyse a recording (``series``: its ``extract(rec)`` if the caller has it already)."""
+    series = extract(rec) if series is None else series
+    dt = series.dt
+    result = rec.result or {}
+    statuses = {a["name"]: a.get("status") for a in result.get("agvs", [])}
+    obstacle_gap, agv_gap = _clearances(series)
+    collisions = [e for e in series.events if e.get("kind") == "collision"]
+    hits = Counter(n for e in collisions for n in e.get("agvs", []))
+    agvs, cycles = [], []
+    for i, name in enumerate(series.agvs.names):
+        clearance = (_finite(obstacle_gap[i]), _finite(agv_gap[i]))
+        agv, plan_times = _agv(series, i, dt, statuses.get(name), hits[name], clearance)
+        agvs.append(agv)
+        cycles.append(plan_times)
+    plan_times = np.concatenate(cycles) if cycles else np.zeros(0)
+    run = rec.run
+    return RunAnalysis(
+        path=str(rec.path),
+        scenario=str(run.get("scenario", result.get("scenario", ""))),
+        run_id=str(run.get("run_id", "")),
+        finished=rec.result is not None,
+        truncated=rec.truncated,
+        dt=dt,
+        ticks=int(series.tick[-1]) if len(series.tick) else 0,
+        run_time=float(series.time[-1]) if len(series.time) else 0.0,
+        arrived=sum(a.status == "arrived" for a in agvs),
+        collisions=len(collisions),
+        path_length=_mean(a.path_length for a in agvs),
+        distance=_mean(a.distance for a in agvs),
+        turns=_mean(a.turns for a in agvs),
+        turning_angle_deg=_mean(a.turning_angle_deg for a in agvs),
+        rms_accel=_mean(a.rms_accel for a in agvs),
+        rms_jerk=_mean(a.rms_jerk for a in agvs),
+        mean_abs_domega=_mean(a.mean_abs_domega for a in agvs),
+        omega_sign_changes=_mean(a.omega_sign_changes for a in agvs),
+        min_clearance_obstacles=_least(a.min_clearance_obstacles for a in agvs),
+        min_clearance_agvs=_least(a.min_clearance_agvs for a in agvs),
+        replans=sum(a.replans for a in agvs),
+        plan_time_mean_ms=float(plan_times.mean()) if len(plan_times) else None,
+        plan_time_p95_ms=float(np.percentile(plan_times, 95)) if len(plan_times) else None,
+        agvs=tuple(agvs),
+    )
+
+
+def _agv(
+    series: RunSeries, i, dt, final_status, collisions, clearance
+) -> tuple[AgvAnalysis, np.ndarray]:
+    """One AGV's analysis and the planning times of its control cycles."""
+    col = {f: v[:, i] for f, v in series.agvs.columns.items()}
+    rows = np.flatnonzero(~np.isnan(col["x"]))
+    col = {f: v[rows] for f, v in col.items()}
+    status = series.agvs.labels["status"][rows, i]
+    time = series.time[rows]
+    done = np.flatnonzero(np.isin(status, DONE))
+    end = int(done[0]) if len(done) else len(rows) - 1
+    arrived = len(done) > 0 and status[end] == "arrived"
+    drive = slice(0, end + 1)
+    x, y = col["x"], col["y"]
+    name = series.agvs.names[i]
+    path = _first_path(series.plans.get(name, []))
+    motion = _smoothness(col, drive, dt)
+    plan_times = col["plan_time_ms"][1 : end + 1]
+    agv = AgvAnalysis(
+        name=name,
+        status=final_status or (str(status[-1]) if len(status) else "unknown"),
+        arrival_time=float(time[end]) if arrived else None,
+        distance=float(np.hypot(np.diff(x), np.diff(y)).sum()),
+        path_length=None if path is None else path_metrics.path_length(path),
+        turns=None if path is None else path_metrics.turning_times(path),
+        turning_angle_deg=None if path is None else path_metrics.total_turning_angle_deg(path),
+        replans=sum(p.get("reason") == "replan" for p in series.plans.get(name, [])),
+        **motion,
+        min_clearance_obstacles=clearance[0],
+        min_clearance_agvs=clearance[1],
+        collisions=collisions,
+        plan_time_mean_ms=float(plan_times.mean()) if len(plan_times) else None,
+        plan_time_p95_ms=float(np.percentile(plan_times, 95)) if len(plan_times) else None,
+    )
+    return agv, plan_times
+
+
+def _first_path(plans: list[dict]):
+    for plan in plans:
+        if plan.get("found") and plan.get("key_nodes"):
+            return plan["key_nodes"]
+    return None
+
+
+def _smoothness(col: dict[str, np.ndarray], drive: slice, dt: float | None) -> dict:
+    omega = col["omega"][drive]
+    turning = np.sign(omega[omega != 0])
+    out = {
+        "mean_abs_domega": float(np.abs(np.diff(omega)).mean()) if len(omega) > 1 else None,
+        "omega_sign_changes": int(np.count_nonzero(turning[1:] != turning[:-1])),
+        "rms_accel": None,
+        "rms_jerk": None,
+        "rms_speed_accel": None,
+        "rms_speed_jerk": None,
+    }
+    if dt is None:
+        return out
+    velocity = world_velocity(col["theta"][drive], col["vx"][drive], col["vy"][drive], omega, dt)
+    speed = np.hypot(velocity[:, 0], velocity[:, 1])
+    accel = np.diff(velocity, axis=0) / dt
+    speed_accel = np.diff(speed) / dt
+    out["rms_accel"] = _rms(accel)
+    out["rms_jerk"] = _rms(np.diff(accel, axis=0) / dt)
+    out["rms_speed_accel"] = _rms(speed_accel)
+    out["rms_speed_jerk"] = _rms(np.diff(speed_accel) / dt)
+    return out
+
+
+def world_velocity(theta, vx, vy, omega, dt: float) -> np.ndarray:
+    """(n, 2) world-frame velocity of states: each body-frame command (vx, vy) turned by
+    the heading it was applied at, theta - omega*dt (Eq. 4 moves the pose with the
+    heading before the step; this equals the position difference over dt)."""
+    heading = theta - omega * dt
+    c, s = np.cos(heading), np.sin(heading)
+    return np.column_stack((vx * c - vy * s, vx * s + vy * c))
+
+
+def _rms(values: np.ndarray) -> float | None:
+    """Root mean square of scalars, or of vector norms (rows)."""
+    if len(values) == 0:
+        return None
+    squares = values**2 if values.ndim == 1 else (values**2).sum(axis=1)
+    return float(math.sqrt(squares.mean()))
+
+
+def _clearances(series: RunSeries) -> tuple[np.ndarray, np.ndarray]:
+    """Per AGV, the least clearance to obstacles and to other AGVs over the run (inf: none)."""
+    xs, ys = series.agvs.columns["x"], series.agvs.columns["y"]
+    radius = series.agvs.columns["radius"]
+    count = len(series.agvs.names)
+    obstacles = np.full(count, math.inf)
+    if series.grid is not None and len(xs):
+        base = DistanceField.from_grid(series.grid)
+        groups: dict[tuple, list[int]] = {}
+        for t, cells in enumerate(series.temporary):
+            groups.setdefault(cells, []).append(t)
+        for cells, rows in groups.items():
+            field = base.with_blocked(list(cells)) if cells else base
+            gaps = field.distance_at(xs[rows], ys[rows]) - radius[rows]
+            obstacles = np.fmin(obstacles, _column_min(gaps))
+    mov = series.moving.columns
+    for m in range(len(series.moving.names)):
+        gaps = (
+            np.hypot(xs - mov["x"][:, m : m + 1], ys - mov["y"][:, m : m + 1])
+            - radius
+            - mov["radius"][:, m : m + 1]
+        )
+        obstacles = np.fmin(obstacles, _column_min(gaps))
+    others = np.full(count, math.inf)
+    for i in range(count - 1):
+        rest = slice(i + 1, None)
+        gaps = (
+            np.hypot(xs[:, rest] - xs[:, i : i + 1], ys[:, rest] - ys[:, i : i + 1])
+            - radius[:, rest]
+            - radius[:, i : i + 1]
+        )
+        pair = _column_min(gaps)  # AGV i against each later AGV
+        others[i] = np.fmin(others[i], pair.min(initial=math.inf))
+        others[rest] = np.fmin(others[rest], pair)
+    return obstacles, others
+
+
+def _column_min(values: np.ndarray) -> np.ndarray:
+    """Minimum of each column ignoring NaN (inf for an all-NaN column)."""
+    return np.fmin.reduce(values, axis=0, initial=math.inf)
+
+
+def _finite(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+def _mean(values) -> float | None:
+    kept = [v for v in values if v is not None]
+    return float(np.mean(kept)) if kept else None
+
+
+def _least(values) -> float | None:
+    kept = [v for v in values if v is not None]
+    return min(kept) if kept else None
+
+
+def json_ready(value):
+    """JSON-ready: numbers rounded to 6 significant decimals, NaN/inf as None."""
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_ready(v) for v in value]
+    if isinstance(value, float):
+        return round(value, 6) if math.isfinite(value) else None
+    return value
+
+
+# --- comparison ---------------------------------------------------------------------
+COMPARED = (
+    ("run_time", "run time", "s"),
+    ("arrived", "arrived", "AGVs"),
+    ("collisions", "collisions", ""),
+    ("path_length", "mean path length", "m"),
+    ("distance", "mean distance", "m"),
+    ("turns", "mean turns", ""),
+    ("turning_angle_deg", "mean turning angle", "deg"),
+    ("rms_accel", "mean RMS acceleration", "m/s²"),
+    ("rms_jerk", "mean RMS jerk", "m/s³"),
+    ("mean_abs_domega", "mean |Δω| per tick", "rad/s"),
+    ("omega_sign_changes", "mean ω sign changes", ""),
+    ("min_clearance_obstacles", "min clearance obstacles", "m"),
+    ("min_clearance_agvs", "min clearance AGVs", "m"),
+    ("replans", "replans", ""),
+    ("plan_time_mean_ms", "plan time mean", "ms"),
+    ("plan_time_p95_ms", "plan time p95", "ms"),
+)
+
+
+@dataclass(frozen=True)
+class ComparedMetric:
+    key: str
+    label: str
+    unit: str
+    values: tuple[float | None, ...]  # one per run, in the order given
+    change_pct: tuple[float | None, ...]  # each run against the first (None: undefined)
+
+
+def compare(runs: Sequence[RunAnalysis]) -> list[ComparedMetric]:
+    """Run-level metrics side by side with the % difference to the first run (as the
+    paper's Table 4 compares algorithms)."""
+    rows = []
+    for key, label, unit in COMPARED:
+        values = tuple(getattr(r, key) for r in runs)
+        first = values[0] if values else None
+        change = tuple(
+            None if v is None or not first else 100.0 * (v - first) / abs(first) for v in values
+        )
+        rows.append(ComparedMetric(key, label, unit, values, change))
+    return rows

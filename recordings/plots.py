@@ -1,0 +1,101 @@
+"""PNG plots of a run: the map with trajectories (the paper's Fig. 10) and v(t), ω(t)
+per AGV (Fig. 11). Matplotlib's object API with the Agg canvas: no pyplot, no
+global backend, nothing needs a display."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+
+from recordings.analysis import world_velocity
+from recordings.series import RunSeries
+
+DPI = 100
+LEGEND_MAX = 12  # more AGVs than this: no legend, it would cover the map
+
+
+def save_plots(series: RunSeries, out_dir: Path, stem: str) -> list[Path]:
+    """Write ``<stem>-map.png`` and ``<stem>-velocity-<agv>.png`` into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    paths = [_save(_map_figure(series), out_dir / f"{stem}-map.png")]
+    for i, name in enumerate(series.agvs.names):
+        figure = _velocity_figure(series, i)
+        paths.append(_save(figure, out_dir / f"{stem}-velocity-{name}.png"))
+    return paths
+
+
+def _save(figure: Figure, path: Path) -> Path:
+    FigureCanvasAgg(figure)
+    figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
+    return path
+
+
+def _map_figure(series: RunSeries) -> Figure:
+    grid = series.grid
+    width, height = grid.size_m if grid else (10.0, 10.0)
+    scale = 8.0 / max(width, height)
+    figure = Figure(figsize=(max(4.0, width * scale) + 2.5, max(3.0, height * scale) + 0.8))
+    ax = figure.add_subplot()
+    if grid is not None:
+        ax.imshow(
+            grid.blocked, origin="lower", extent=(0, width, 0, height), cmap="Greys",
+            vmin=0, vmax=1.4, interpolation="nearest",
+        )  # fmt: skip
+        _temporary_cells(ax, series, grid.resolution)
+    mov = series.moving.columns
+    for m in range(len(series.moving.names)):
+        ax.plot(mov["x"][:, m], mov["y"][:, m], color="tab:gray", lw=0.8, ls="--")
+    columns = series.agvs.columns
+    for i, name in enumerate(series.agvs.names):
+        colour = f"C{i % 10}"
+        plans = series.plans.get(name, [])
+        first = next((p for p in plans if p.get("found")), None)
+        if first is not None:
+            path = np.asarray(first["path"], dtype=float).reshape(-1, 2)
+            nodes = np.asarray(first["key_nodes"], dtype=float).reshape(-1, 2)
+            ax.plot(path[:, 0], path[:, 1], color=colour, lw=0.8, ls=":", alpha=0.8)
+            ax.plot(nodes[:, 0], nodes[:, 1], "o", mfc="none", mec=colour, ms=5)
+        x, y = columns["x"][:, i], columns["y"][:, i]
+        ax.plot(x, y, color=colour, lw=1.6, label=name)
+        if len(x):
+            ax.plot(x[0], y[0], "s", color=colour, ms=5)
+    ax.set_xlim(0, width)
+    ax.set_ylim(0, height)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title("trajectories (solid), first global path (dotted), key nodes (o)")
+    if 0 < len(series.agvs.names) <= LEGEND_MAX:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+    figure.tight_layout()
+    return figure
+
+
+def _temporary_cells(ax, series: RunSeries, resolution: float) -> None:
+    """Every temporary obstacle cell shown during the run, as orange squares."""
+    for col, row in sorted({c for shown in series.temporary for c in shown}):
+        square = (col * resolution, row * resolution)
+        ax.add_patch(Rectangle(square, resolution, resolution, color="tab:orange", alpha=0.8))
+
+
+def _velocity_figure(series: RunSeries, i: int) -> Figure:
+    c = {f: v[:, i] for f, v in series.agvs.columns.items()}
+    t = series.time
+    figure = Figure(figsize=(7.0, 4.5))
+    speed_ax, omega_ax = figure.subplots(2, 1, sharex=True)
+    if series.dt is not None:
+        velocity = world_velocity(c["theta"], c["vx"], c["vy"], c["omega"], series.dt)
+        speed_ax.plot(t, np.hypot(velocity[:, 0], velocity[:, 1]), color="tab:blue", lw=1.0)
+    omega_ax.plot(t, c["omega"], color="tab:red", lw=1.0)
+    speed_ax.set_ylabel("v (m/s)")
+    omega_ax.set_ylabel("ω (rad/s)")
+    omega_ax.set_xlabel("sim time (s)")
+    speed_ax.set_title(f"{series.agvs.names[i]}: linear and angular velocity")
+    for ax in (speed_ax, omega_ax):
+        ax.grid(True, lw=0.4, alpha=0.6)
+    figure.tight_layout()
+    return figure

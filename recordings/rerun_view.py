@@ -1,0 +1,160 @@
+"""Showing runs in Rerun: replay a recording, or watch a run live.
+
+Outputs: an ``.rrd`` file, the web viewer served on 127.0.0.1, or the native viewer
+(which needs a display). A replay sends a whole recording at once, or paces it at
+``rate`` x real time; the live view sends what the run made every 0.1 s. Both go
+through ``recordings.rerun_rows`` (whose docstring lists the entity paths) and
+``recordings.rerun_log``, so they show the same entities with the same blueprint.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+import uuid
+from contextlib import ExitStack, suppress
+from pathlib import Path
+
+import rerun as rr
+
+from bridge import keys
+from bridge.messages import to_dict
+from recordings.rerun_log import Live, recording_dt, send_recording
+from recordings.rerun_server import RerunError, WebServer, open_viewer, require_display
+
+APP_ID = "agv-fleet"
+FLUSH_TIMEOUT = 30.0
+
+__all__ = [
+    "LiveView",
+    "Outputs",
+    "RerunError",
+    "require_display",
+    "save_rrd",
+    "serve_web",
+    "spawn_viewer",
+]
+
+
+class Outputs:
+    """A recording stream and where it goes: ``save`` (an .rrd path) and/or ``web``,
+    else the native viewer. A context manager: the file is complete and the web
+    server gone when the block ends."""
+
+    def __init__(self, *, save: Path | str | None = None, web: bool = False, notify=sys.stderr):
+        self.stream = rr.RecordingStream(APP_ID, recording_id=uuid.uuid4())
+        self._save = save
+        self._web = web
+        self._notify = notify
+        self._server: WebServer | None = None
+        self._exit = ExitStack()
+
+    def __enter__(self) -> Outputs:
+        with self._exit:
+            sinks = []
+            if self._save is not None:
+                sinks.append(rr.FileSink(str(self._save)))
+            if self._web:
+                self._server = self._exit.enter_context(WebServer())
+                sinks.append(rr.GrpcSink(self._server.grpc_url))
+            if not sinks:
+                sinks.append(rr.GrpcSink(open_viewer()))
+            try:
+                self.stream.set_sinks(*sinks)
+            except RuntimeError as err:  # a file it cannot create
+                raise RerunError(str(err)) from None
+            self._exit.callback(self._close_stream)
+            if self._server is not None:
+                print(f"Rerun web viewer: {self._server.web_url}", file=self._notify, flush=True)
+            self._exit = self._exit.pop_all()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._exit.close()
+
+    def _close_stream(self) -> None:
+        """Deliver what was logged, then close the sinks (this writes the .rrd footer)."""
+        try:
+            self.stream.flush(timeout_sec=FLUSH_TIMEOUT)
+        except RuntimeError as err:
+            # A Ctrl-C in the terminal ends the web server too: nobody is left to deliver to.
+            if self._server is None or self._server.running:
+                raise RerunError(f"Rerun did not get everything: {err}") from None
+        finally:
+            self.stream.disconnect()
+
+    def replay(self, recording, rate: float | None = None) -> None:
+        """Send a recording: all at once, or paced at ``rate`` x real time."""
+        if rate is None:
+            send_recording(self.stream, recording.messages)
+        else:
+            _paced(Live(self.stream, recording_dt(recording.messages)), recording.messages, rate)
+
+    def hold(self) -> None:
+        """With the web viewer: keep serving until Ctrl-C (or the server ends)."""
+        if self._server is None:
+            return
+        self.stream.flush(timeout_sec=FLUSH_TIMEOUT)
+        print("serving; Ctrl-C to stop", file=self._notify, flush=True)
+        with suppress(KeyboardInterrupt):
+            self._server.wait()
+
+
+def _paced(live: Live, messages, rate: float) -> None:
+    start = time.monotonic()
+    for m in messages:
+        if m.topic == keys.WORLD_TICK:
+            delay = start + m.data["time"] / rate - time.monotonic()
+            if delay > 0:
+                live.send()  # what happened up to now, before waiting for the next tick
+                time.sleep(delay)
+        live.feed(m.topic, m.data)
+    live.send()
+
+
+def save_rrd(recording, out_path: Path | str) -> None:
+    """Convert a recording to an .rrd file that ``rerun OUT.rrd`` opens."""
+    with Outputs(save=out_path) as out:
+        out.replay(recording)
+
+
+def serve_web(recording, *, rate: float | None = None, notify=sys.stderr) -> None:
+    """Serve a recording in the web viewer on 127.0.0.1 (the URL goes to ``notify``)
+    until Ctrl-C."""
+    with Outputs(web=True, notify=notify) as out:
+        out.replay(recording, rate)
+        out.hold()
+
+
+def spawn_viewer(recording, *, rate: float | None = None) -> None:
+    """Show a recording in the native viewer (RerunError without a display)."""
+    with Outputs() as out:
+        out.replay(recording, rate)
+
+
+class LiveView:
+    """A run's sink, ``sink(key, msg)``, for ``agv-fleet run --rerun``: every message is
+    shown as it comes, on a ``sim_time`` timeline (``dt``: the scenario's control
+    period, which dates AGV states). Use it as a context manager; ``hold()`` after
+    the run keeps the web viewer up until Ctrl-C."""
+
+    def __init__(self, dt: float, *, save: Path | str | None = None, web: bool = False):
+        self._outputs = Outputs(save=save, web=web)
+        self._live = Live(self._outputs.stream, dt)
+
+    def __enter__(self) -> LiveView:
+        self._outputs.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        try:
+            self._live.send()
+        finally:
+            self._outputs.__exit__(*exc)
+
+    def __call__(self, key: str, msg) -> None:
+        self._live.feed(key, to_dict(msg))
+
+    def hold(self) -> None:
+        self._live.send()
+        self._outputs.hold()

@@ -1,0 +1,100 @@
+"""Recording a real fleet run: the recorder process on the bus, and the same
+recording from both modes; a recorder killed with -9 loses only its last chunk."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+from recordings.reader import open_recording
+from tests.processes import fleet_processes
+
+CLI = [sys.executable, "-m", "fleet.cli"]
+WALL_CLOCK_FIELDS = ("plan_time_ms",)
+
+
+def _without_wall_clock(data):
+    """A message's content less what depends on the machine's speed."""
+    if isinstance(data, dict):
+        return {k: _without_wall_clock(v) for k, v in data.items() if k not in WALL_CLOCK_FIELDS}
+    if isinstance(data, list):
+        return [_without_wall_clock(v) for v in data]
+    return data
+
+
+def _content(path):
+    rec = open_recording(path)
+    assert not rec.truncated
+    out = {}
+    for topic in rec.topics():
+        messages = [(m.log_time_ns, _without_wall_clock(m.data)) for m in rec.of(topic)]
+        if topic == "world/result":
+            messages = [(t, _without_wall_clock(json.loads(d["summary"]))) for t, d in messages]
+            for _, summary in messages:
+                summary.pop("wall_time")
+        out[topic] = sorted(messages, key=lambda m: (m[0], json.dumps(m[1], sort_keys=True)))
+    return rec, out
+
+
+def test_both_modes_record_the_same_run(tmp_path):
+    bus_file, local_file = tmp_path / "bus.mcap", tmp_path / "local.mcap"
+    for extra, path in (([], bus_file), (["--in-process"], local_file)):
+        proc = subprocess.run(
+            [*CLI, "run", "crossing", "-q", "-o", str(path), *extra],
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
+        assert proc.returncode == 0, proc.stderr
+        assert f"recorded to {path}" in proc.stderr
+    bus, bus_content = _content(bus_file)
+    local, local_content = _content(local_file)
+    assert bus_content == local_content
+    assert bus.run["mode"] == "zenoh" and local.run["mode"] == "in-process"
+    assert bus.result["agvs"] == local.result["agvs"]
+
+
+def _recorder_pid(timeout=30.0) -> int:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        for pid in fleet_processes():
+            with open(f"/proc/{pid}/cmdline", "rb") as f:
+                args = f.read().split(b"\0")
+            if args[3:5] == [b"fleet.cli", b"record"]:  # python -P -m fleet.cli record ...
+                return pid
+        time.sleep(0.05)
+    raise AssertionError("no recorder process")
+
+
+def test_a_recorder_killed_mid_run_leaves_a_readable_recording(tmp_path):
+    path = tmp_path / "killed.mcap"
+    run = subprocess.Popen(
+        [*CLI, "run", "crossing", "-q", "--json", "--realtime", "5", "-o", str(path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    recorder = _recorder_pid()
+    time.sleep(4.0)  # ~20 s of the 44 s simulated
+    os.kill(recorder, signal.SIGKILL)
+    out, _ = run.communicate(timeout=300)
+    assert run.returncode == 0  # the run itself goes on without its recorder
+    ticks = json.loads(out)["ticks"]
+
+    rec = open_recording(path)
+    assert rec.truncated and rec.result is None
+    states = len(rec.of("agv/west/state"))
+    assert 50 < states < ticks  # what was recorded before the kill, less the open chunk
+    info = subprocess.run([*CLI, "info", str(path)], capture_output=True, text=True, timeout=60)
+    assert info.returncode == 0
+    assert "truncated" in info.stderr and "west" in info.stdout
+    analysis = subprocess.run(
+        [*CLI, "analyze", str(path), "--json"], capture_output=True, text=True, timeout=60
+    )
+    assert analysis.returncode == 0, analysis.stderr
+    assert "truncated" in analysis.stderr
+    assert json.loads(analysis.stdout)

@@ -1,0 +1,315 @@
+"""Rerun views of a run: the .rrd a replay writes, the live view, the web server, errors.
+
+Every .rrd is read back with Rerun's own reader (``rerun.chunk.RrdReader``), so the
+tests check what a viewer would load, not what we meant to send.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import queue
+import re
+import signal
+import subprocess
+import sys
+import threading
+import time
+import urllib.request
+from pathlib import Path
+from urllib.parse import urlparse
+
+import pytest
+from rerun.chunk import RrdReader
+
+from bridge.messages import MessageError
+from fleet.builtin import builtin_scenarios
+from fleet.inprocess import run_in_process
+from fleet.scenario import load_scenario
+from recordings.reader import open_recording
+from recordings.rerun_rows import QUANTITIES, RowMaker, blocked_rectangles
+from recordings.rerun_view import LiveView, Outputs, save_rrd
+from recordings.writer import RecordingWriter, record_sink
+
+AGV_PARTS = ("body", "heading", "trail", "plan", "plan/key_nodes", "dwa")
+
+
+class Entity:
+    """What an .rrd holds for one entity: static rows, and temporal rows as
+    (sim_time ns, {component: value}) sorted by time."""
+
+    def __init__(self):
+        self.static = 0
+        self.rows: list[tuple[int, dict]] = []
+
+    def values(self, component: str) -> list:
+        return [row[component] for _, row in self.rows]
+
+
+def read_rrd(path: Path) -> dict[str, Entity]:
+    entities: dict[str, Entity] = {}
+    for chunk in RrdReader(str(path)).stream():
+        entity = entities.setdefault(chunk.entity_path, Entity())
+        if chunk.is_static:
+            entity.static += chunk.num_rows
+            continue
+        batch = chunk.to_record_batch()
+        names = [n for n in batch.schema.names if ":" in n]
+        times = batch.column("sim_time").cast("int64").to_pylist()
+        columns = {n: batch.column(n).to_pylist() for n in names}
+        for i, t in enumerate(times):
+            entity.rows.append((t, {n: columns[n][i] for n in names}))
+    for entity in entities.values():
+        entity.rows.sort(key=lambda row: (row[0], repr(row[1])))
+    return entities
+
+
+@pytest.fixture(scope="module")
+def corridor(tmp_path_factory):
+    """The built-in corridor run once in process, recorded to MCAP and watched live
+    into an .rrd at the same time."""
+    folder = tmp_path_factory.mktemp("corridor")
+    scenario = load_scenario("corridor")
+    mcap, live = folder / "corridor.mcap", folder / "live.rrd"
+    text = builtin_scenarios()["corridor"].read_text()
+    with (
+        RecordingWriter(mcap, scenario_name="corridor", scenario_text=text, run_facts={}) as w,
+        LiveView(scenario.dt, save=live) as view,
+    ):
+        record = record_sink(w, scenario.dt)
+
+        def both(key, msg):
+            record(key, msg)
+            view(key, msg)
+
+        summary = run_in_process(scenario, sink=both)
+        w.finish(summary.to_json())
+    return {"mcap": mcap, "live": live, "recording": open_recording(mcap), "dt": scenario.dt}
+
+
+@pytest.fixture(scope="module")
+def replayed(corridor, tmp_path_factory):
+    out = tmp_path_factory.mktemp("replay") / "corridor.rrd"
+    save_rrd(corridor["recording"], out)
+    return read_rrd(out)
+
+
+def test_a_saved_replay_has_the_map_every_agv_its_plans_and_velocities(corridor, replayed):
+    recording = corridor["recording"]
+    names = recording.agv_names()
+    assert names == ["left", "right"]
+    assert replayed["/world/map"].static == 1
+    assert replayed["/world"].static == 1  # the y flip
+    ticks = recording.of("world/tick")
+    for name in names:
+        for part in AGV_PARTS:
+            assert f"/world/agv/{name}/{part}" in replayed, part
+        assert len(replayed[f"/world/agv/{name}/body"].rows) == len(ticks)
+        plans = recording.of(f"agv/{name}/plan")
+        assert len(replayed[f"/world/agv/{name}/plan"].rows) == len(plans) >= 1
+        states = recording.of(f"agv/{name}/state")
+        for q in QUANTITIES:
+            series = replayed[f"/velocity/{q}/{name}"]
+            assert len(series.rows) == len(states), q
+            assert series.static == 1  # its name and colour in the plot
+    assert len(replayed["/events"].rows) == len(recording.of("world/event"))
+
+
+def test_velocity_rows_are_the_states_at_their_tick_time(corridor, replayed):
+    states = [m.data for m in corridor["recording"].of("agv/left/state")]
+    speed = replayed["/velocity/speed/left"]
+    assert [t for t, _ in speed.rows] == [round(s["tick"] * corridor["dt"] * 1e9) for s in states]
+    got = [v[0] for v in speed.values("Scalars:scalars")]
+    assert got == pytest.approx([math.hypot(s["vx"], s["vy"]) for s in states])
+    omega = [v[0] for v in replayed["/velocity/omega/left"].values("Scalars:scalars")]
+    assert omega == pytest.approx([s["omega"] for s in states])
+
+
+def test_agv_discs_follow_the_ticks_in_world_coordinates(corridor, replayed):
+    ticks = [m.data for m in corridor["recording"].of("world/tick")]
+    body = replayed["/world/agv/right/body"]
+    assert [t for t, _ in body.rows] == [round(k["time"] * 1e9) for k in ticks]
+    poses = [next(a for a in k["agvs"] if a["name"] == "right") for k in ticks]
+    positions = [p[0] for p in body.values("Points2D:positions")]
+    assert positions == [pytest.approx([a["x"], a["y"]], abs=1e-5) for a in poses]
+    assert body.values("Points2D:radii")[0] == [pytest.approx(poses[0]["radius"])]
+
+
+def test_a_replan_replaces_the_plan_and_the_dwa_trajectory_clears_on_arrival(replayed):
+    plan = replayed["/world/agv/left/plan"]
+    assert all(len(strips) == 1 for strips in plan.values("LineStrips2D:strips"))
+    dwa = replayed["/world/agv/left/dwa"].values("LineStrips2D:strips")
+    assert dwa[-1] == [] and all(len(s) == 1 for s in dwa[:-1])
+
+
+def test_the_live_view_shows_what_the_replay_shows(corridor, replayed):
+    live = read_rrd(corridor["live"])
+    assert set(live) == set(replayed)
+    for path, entity in replayed.items():
+        assert live[path].static == entity.static, path
+        assert live[path].rows == entity.rows, path
+
+
+def test_blocked_cells_merge_into_rectangles_with_row_zero_at_the_bottom():
+    rows_top_down = ["#...", "##.#", "##.#"]
+    assert blocked_rectangles(rows_top_down) == [(0, 0, 2, 2), (0, 2, 1, 3), (3, 0, 4, 2)]
+
+
+def test_a_message_that_does_not_fit_its_topic_is_a_message_error():
+    with pytest.raises(MessageError, match="world/tick"):
+        RowMaker(0.1).feed("world/tick", {"tick": 0, "time": 0.0})
+
+
+def test_a_paced_replay_takes_its_time_and_sends_the_same_rows(corridor, replayed, tmp_path):
+    recording = corridor["recording"]
+    rate = 200.0
+    duration = recording.of("world/tick")[-1].data["time"] / rate
+    t0 = time.monotonic()
+    with Outputs(save=tmp_path / "paced.rrd") as out:
+        out.replay(recording, rate=rate)
+    assert time.monotonic() - t0 >= duration
+    paced = read_rrd(tmp_path / "paced.rrd")
+    assert {p: e.rows for p, e in paced.items()} == {p: e.rows for p, e in replayed.items()}
+
+
+# --- the command line -----------------------------------------------------------------
+
+
+def agv_fleet(*args: str, display: str | None = None) -> subprocess.CompletedProcess:
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    if display is not None:
+        env["DISPLAY"] = display
+    return subprocess.run(
+        [sys.executable, "-m", "fleet.cli", *args],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def one_line(text: str) -> str:
+    lines = text.strip().splitlines()
+    assert len(lines) == 1, text
+    return lines[0]
+
+
+def test_replay_save_writes_an_rrd_with_one_velocity_row_per_state(corridor, tmp_path):
+    out = tmp_path / "out.rrd"
+    done = agv_fleet("replay", str(corridor["mcap"]), "--save", str(out))
+    assert done.returncode == 0, done.stderr
+    entities = read_rrd(out)
+    for name in ("left", "right"):
+        states = corridor["recording"].of(f"agv/{name}/state")
+        assert len(entities[f"/velocity/vx/{name}"].rows) == len(states)
+
+
+def test_replay_without_a_display_or_save_or_web_exits_2_with_one_line(corridor):
+    done = agv_fleet("replay", str(corridor["mcap"]))
+    assert done.returncode == 2
+    line = one_line(done.stderr)
+    assert "no display" in line and "--save" in line and "--web" in line
+
+
+def test_replay_when_the_viewer_cannot_open_a_window_exits_2_with_one_line(corridor):
+    done = agv_fleet("replay", str(corridor["mcap"]), display=":4321")  # no X server there
+    assert done.returncode == 2
+    assert "the Rerun viewer did not start" in one_line(done.stderr)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["{tmp}/missing.mcap", "--save", "{tmp}/x.rrd"], "no such file"),
+        (["{tmp}/notes.mcap", "--save", "{tmp}/x.rrd"], "not an MCAP recording"),
+        (["{mcap}", "--save", "{tmp}/no/such/folder/x.rrd"], "No such file or directory"),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--rate", "2"], "--rate paces the viewer or --web"),
+    ],
+)
+def test_replay_errors_exit_2_with_one_line(corridor, tmp_path, args, message):
+    (tmp_path / "notes.mcap").write_text("not a recording\n")
+    done = agv_fleet("replay", *(a.format(tmp=tmp_path, mcap=corridor["mcap"]) for a in args))
+    assert done.returncode == 2
+    assert message in one_line(done.stderr)
+
+
+def test_a_truncated_recording_replays_what_was_recovered_and_says_so(corridor, tmp_path):
+    data = corridor["mcap"].read_bytes()
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(data[: len(data) // 2])
+    recovered = open_recording(cut)
+    states = recovered.of("agv/left/state")
+    assert 0 < len(states) < len(corridor["recording"].of("agv/left/state"))
+    out = tmp_path / "cut.rrd"
+    done = agv_fleet("replay", str(cut), "--save", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "cut short" in done.stderr and "replaying what was recovered" in done.stderr
+    assert len(read_rrd(out)["/velocity/speed/left"].rows) == len(states)
+
+
+def listening_hosts(pid: int) -> set[str]:
+    """The local addresses (hex, as in /proc/net/tcp) that a process listens on."""
+    inodes = set()
+    for fd in os.listdir(f"/proc/{pid}/fd"):
+        link = os.readlink(f"/proc/{pid}/fd/{fd}")
+        if link.startswith("socket:["):
+            inodes.add(link[8:-1])
+    hosts = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        for line in Path(table).read_text().splitlines()[1:]:
+            fields = line.split()
+            if fields[3] == "0A" and fields[9] in inodes:  # 0A: LISTEN
+                hosts.add(fields[1].split(":")[0])
+    return hosts
+
+
+def alive(pid: int) -> bool:
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def test_replay_web_serves_on_loopback_only_until_ctrl_c_and_ends_its_server(corridor):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    process = subprocess.Popen(
+        [sys.executable, "-m", "fleet.cli", "replay", str(corridor["mcap"]), "--web"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    lines: queue.Queue[str | None] = queue.Queue()
+
+    def read_stderr():
+        for line in process.stderr:
+            lines.put(line)
+        lines.put(None)  # the end: it exited
+
+    threading.Thread(target=read_stderr, daemon=True).start()
+    server = None
+    try:
+        seen = []
+        while not any(line.startswith("serving") for line in seen):
+            line = lines.get(timeout=60)
+            assert line is not None, "".join(seen)
+            seen.append(line)
+        url = re.search(r"Rerun web viewer: (\S+)", "".join(seen)).group(1)
+        assert urlparse(url).hostname == "127.0.0.1"
+        with urllib.request.urlopen(url, timeout=10) as page:
+            assert page.status == 200
+        children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
+        (server,) = map(int, children.split())
+        assert listening_hosts(server) == {"0100007F"}  # 127.0.0.1, gRPC and web alike
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=30) == 0
+        deadline = time.monotonic() + 10
+        while alive(server) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not alive(server)
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+        if server is not None and alive(server):
+            os.kill(server, signal.SIGKILL)
