@@ -5,7 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
-from fleet import node_commands, plan_command, record_commands, replay_command, run_command
+from fleet import (
+    node_commands,
+    paper_command,
+    plan_command,
+    record_commands,
+    replay_command,
+    run_command,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -19,6 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
     node_commands.add_parsers(sub)
     record_commands.add_parsers(sub)
     replay_command.add_parsers(sub)
+    paper_command.add_parsers(sub)
     return parser
 
 

@@ -1,0 +1,248 @@
+"""``agv-fleet paper``: the paper's experiments (section 5), recorded, then reported.
+
+Every experiment is first written to MCAP recordings under the runs folder; the
+report is then built only from those recordings, read back:
+
+- Tables 2 and 3: one plan recording per map (``world/map`` and a ``PlanMsg`` on
+  ``agv/traditional/plan`` and ``agv/improved/plan``), measured by
+  ``recordings.plan_metrics`` from the recorded key nodes. The 20x20 maps are the
+  five bundled literature maps (start = the free cell nearest the bottom-left
+  corner, goal = nearest the top-right); the 50x50 maps are seeded random maps
+  with 20-30 % obstacles from (0, 0) to (49, 49). Seeds without a traditional
+  path are recorded too, then skipped and counted.
+- Figs. 8-11, Table 4 and the velocity-smoothness comparison: the built-in paper
+  scenarios run in process with one planner variant each, recorded, measured by
+  ``recordings.analysis``.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bridge.keys import WORLD_MAP, agv_plan
+from bridge.messages import PlanMsg
+from fleet.builtin import bundled_maps
+from fleet.inprocess import run_in_process
+from fleet.scenario import load_scenario, with_algorithm
+from fleet.world import map_message
+from planner.global_planner import PlanResult, plan_global, warm_up
+from planner.grid_map import GridMap
+from planner.map_io import load_matrix_text
+from planner.random_map import random_map
+from recordings.analysis import RunAnalysis, analyze
+from recordings.plan_metrics import MapPlans, map_plans
+from recordings.reader import open_recording
+from recordings.series import RunSeries, extract
+from recordings.writer import RecordingWriter, record_sink
+
+PLAN_ALGORITHMS = ("traditional", "improved")
+RANDOM_SIZE = 50
+DEFAULT_MAPS50 = 50
+QUICK_MAPS50 = 5
+# every (scenario, planner variant) run, in order
+FLEET_RUNS = (
+    ("paper-concave", "dwa"),
+    ("paper-concave", "fusion"),
+    ("paper-concave", "astar-dwa"),
+    ("paper-temporary-0", "fusion"),
+    ("paper-temporary-1", "fusion"),
+    ("paper-temporary-2", "fusion"),
+    ("paper-temporary-3", "fusion"),
+    ("paper-temporary-3", "astar-dwa"),
+    ("paper-temporary-3", "dwa"),
+    ("paper-dynamic", "fusion"),
+    ("paper-dynamic", "astar-dwa"),
+    ("paper-dynamic", "dwa"),
+)
+
+Log = Callable[[str], None]
+
+
+@dataclass
+class FleetRun:
+    scenario: str
+    algorithm: str
+    recording: Path
+    analysis: RunAnalysis
+    series: RunSeries
+
+
+@dataclass
+class PaperResults:
+    """Everything the report needs, read back from the recordings."""
+
+    runs_dir: Path
+    grid20: list[MapPlans]
+    random50: list[MapPlans]  # every seed tried, with or without a path
+    maps50_wanted: int
+    fleet: dict[tuple[str, str], FleetRun] = field(default_factory=dict)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    def run(self, scenario: str, algorithm: str) -> FleetRun:
+        return self.fleet[(scenario, algorithm)]
+
+
+def random_ratio(seed: int) -> float:
+    """Obstacle ratio of the seeded 50x50 map: 20 % to 30 % in 1 % steps, by seed."""
+    return 0.20 + 0.10 * (seed % 11) / 10
+
+
+def corner_free_cell(grid: GridMap, corner: str) -> tuple[int, int]:
+    """The free cell nearest the bottom-left (or else the top-right) corner."""
+    rows, cols = np.nonzero(~grid.blocked)
+    if corner == "bottom-left":
+        key = rows + cols
+    else:
+        key = (grid.height - 1 - rows) + (grid.width - 1 - cols)
+    i = int(np.lexsort((cols, key))[0])
+    return int(cols[i]), int(rows[i])
+
+
+def grid20_maps() -> dict[str, Path]:
+    """The bundled 20x20 literature maps, by name."""
+    return {n: p for n, p in bundled_maps().items() if n.startswith("map20_")}
+
+
+def _plan_msg(name: str, plan: PlanResult) -> PlanMsg:
+    return PlanMsg(
+        name=name,
+        tick=0,
+        time=0.0,
+        algorithm=plan.algorithm,
+        reason="initial",
+        found=plan.found,
+        path=[list(p) for p in plan.path],
+        key_nodes=[list(p) for p in plan.key_nodes],
+        length=plan.length if plan.found else 0.0,
+        turns=plan.turns if plan.found else 0,
+        turning_angle_deg=plan.turning_angle_deg if plan.found else 0.0,
+        plan_time_ms=plan.time_s * 1e3,
+    )
+
+
+def _scenario_text(name: str, map_table: str, start, goal) -> str:
+    """A scenario file with the map and one AGV per algorithm: the planning problem."""
+    agvs = "".join(
+        f'\n[[agvs]]\nname = "{a}"\nstart = [{start[0]}, {start[1]}]\ngoal = [{goal[0]}, '
+        f"{goal[1]}]\n"
+        f'planner = {{ algorithm = "{"fusion" if a == "improved" else "astar-dwa"}" }}\n'
+        for a in PLAN_ALGORITHMS
+    )
+    description = "global plans, traditional vs improved A*"
+    return f'name = "{name}"\ndescription = "{description}"\n\n{map_table}{agvs}'
+
+
+def record_plans(path: Path, grid: GridMap, start, goal, name: str, facts: dict, map_table: str):
+    """Plan with both A* variants and record the map and both plans into ``path``."""
+    text = _scenario_text(name, map_table, start, goal)
+    run_facts = {"mode": "plan", "map": grid.name, "start": list(start), "goal": list(goal)}
+    with RecordingWriter(
+        path, scenario_name=name, scenario_text=text, run_facts={**run_facts, **facts}
+    ) as writer:
+        writer.write(WORLD_MAP, map_message(grid), 0)
+        found = {}
+        for algorithm in PLAN_ALGORITHMS:
+            plan = plan_global(grid, start, goal, algorithm)
+            writer.write(agv_plan(algorithm), _plan_msg(algorithm, plan), 0)
+            found[algorithm] = plan.found
+        writer.finish({"found": found})
+
+
+def record_grid20(plan_dir: Path, log: Log) -> list[Path]:
+    paths = []
+    for name, file in grid20_maps().items():
+        grid = load_matrix_text(file)
+        start = grid.centre_of(corner_free_cell(grid, "bottom-left"))
+        goal = grid.centre_of(corner_free_cell(grid, "top-right"))
+        path = plan_dir / f"table2-{name}.mcap"
+        table = f'[map]\nfile = "maps/{file.name}"\nresolution = 1.0\n'
+        record_plans(path, grid, start, goal, f"table2-{name}", {"table": 2}, table)
+        paths.append(path)
+    log(f"Table 2: planned and recorded {len(paths)} 20x20 maps")
+    return paths
+
+
+def record_random50(plan_dir: Path, wanted: int, log: Log) -> list[Path]:
+    """Seeded 50x50 maps until ``wanted`` of them have a path (at most 20x as many seeds)."""
+    paths, made, seed = [], 0, 0
+    start, goal = (0.5, 0.5), (RANDOM_SIZE - 0.5, RANDOM_SIZE - 0.5)
+    while made < wanted and seed < 20 * max(wanted, 1):
+        ratio = random_ratio(seed)
+        corners = [(0, 0), (RANDOM_SIZE - 1, RANDOM_SIZE - 1)]
+        grid = random_map(RANDOM_SIZE, RANDOM_SIZE, ratio, seed, keep_free=corners)
+        path = plan_dir / f"table3-seed{seed:03d}.mcap"
+        table = (
+            f"[map]\nresolution = 1.0\nrandom = {{ width = {RANDOM_SIZE}, height = {RANDOM_SIZE}, "
+            f"obstacle_ratio = {ratio:.2f}, seed = {seed} }}\n"
+        )
+        facts = {"table": 3, "seed": seed, "obstacle_ratio": ratio}
+        record_plans(path, grid, start, goal, f"table3-seed{seed}", facts, table)
+        paths.append(path)
+        made += open_recording(path).result["found"]["traditional"]
+        seed += 1
+        if seed % 10 == 0:
+            log(f"Table 3: {seed} seeds planned, {made}/{wanted} maps with a path")
+    log(f"Table 3: planned and recorded {seed} seeded 50x50 maps, {made} with a path")
+    return paths
+
+
+def record_fleet_run(fleet_dir: Path, scenario_name: str, algorithm: str) -> Path:
+    scenario = with_algorithm(load_scenario(scenario_name), algorithm)
+    path = fleet_dir / f"{scenario_name}-{algorithm}.mcap"
+    facts = {"mode": "in-process", "algorithm": algorithm, "experiment": "agv-fleet paper"}
+    with RecordingWriter(
+        path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
+    ) as writer:
+        summary = run_in_process(scenario, record_sink(writer, scenario.dt))
+        writer.finish(summary.to_json())
+    return path
+
+
+def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
+    """Record every experiment under ``runs_dir``, then read every recording back."""
+    plan_dir, fleet_dir = runs_dir / "plans", runs_dir / "fleet"
+    for folder in (plan_dir, fleet_dir):
+        folder.mkdir(parents=True, exist_ok=True)
+        for old in folder.glob("*.mcap"):  # a smaller --maps50 must not pick up old maps
+            old.unlink()
+    timings = {}
+    t0 = time.perf_counter()
+    warm_up()
+    grid20_paths = record_grid20(plan_dir, log)
+    random_paths = record_random50(plan_dir, maps50, log)
+    timings["plans"] = time.perf_counter() - t0
+
+    t1 = time.perf_counter()
+    fleet_paths = {}
+    for i, (scenario, algorithm) in enumerate(FLEET_RUNS, 1):
+        t = time.perf_counter()
+        fleet_paths[(scenario, algorithm)] = record_fleet_run(fleet_dir, scenario, algorithm)
+        log(
+            f"run {i}/{len(FLEET_RUNS)}: {scenario} with {algorithm} recorded "
+            f"({time.perf_counter() - t:.1f} s)"
+        )
+    timings["fleet"] = time.perf_counter() - t1
+
+    t2 = time.perf_counter()
+    results = PaperResults(
+        runs_dir=runs_dir,
+        grid20=[map_plans(open_recording(p)) for p in grid20_paths],
+        random50=[map_plans(open_recording(p)) for p in random_paths],
+        maps50_wanted=maps50,
+    )
+    for key, path in fleet_paths.items():
+        rec = open_recording(path)
+        series = extract(rec)
+        results.fleet[key] = FleetRun(*key, path, analyze(rec, series), series)
+    timings["analysis"] = time.perf_counter() - t2
+    results.timings = timings
+    log(
+        f"read back and analysed {len(grid20_paths) + len(random_paths) + len(fleet_paths)} "
+        "recordings"
+    )
+    return results

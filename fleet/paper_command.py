@@ -1,0 +1,80 @@
+"""``agv-fleet paper``: reproduce the paper's experiments, record them, report from them."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+DEFAULT_OUT = "paper-report"
+DEFAULT_RUNS = "runs/paper"
+
+
+def add_parsers(sub) -> None:
+    p = sub.add_parser(
+        "paper",
+        help="reproduce the paper's experiments (Tables 2-4, Figs. 8-11) and write a report",
+        description=(
+            "Run the experiments of Guo et al. 2023 section 5 on the bundled maps and on seeded "
+            "random maps, record every run (MCAP, into --runs), then write a Markdown report "
+            "with tables and PNG figures built from those recordings (into --out)."
+        ),
+    )
+    p.add_argument(
+        "--out",
+        default=DEFAULT_OUT,
+        metavar="DIR",
+        help=f"report folder: DIR/paper-reproduction.md, DIR/figures/ (default {DEFAULT_OUT})",
+    )
+    p.add_argument(
+        "--runs",
+        default=DEFAULT_RUNS,
+        metavar="DIR",
+        help=f"recordings folder (default {DEFAULT_RUNS}); its plans/ and fleet/ are replaced",
+    )
+    p.add_argument(
+        "--maps50",
+        type=_count,
+        metavar="N",
+        help="seeded 50x50 maps with a path to compare (default 50; 5 with --quick)",
+    )
+    p.add_argument("--quick", action="store_true", help="fewer random maps (for tests)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
+    p.set_defaults(handler=run_paper)
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
+    return value
+
+
+def run_paper(args: argparse.Namespace) -> int:
+    # imported here: matplotlib and the experiment code are only needed by this command
+    from fleet.paper import DEFAULT_MAPS50, QUICK_MAPS50, run_experiments
+    from fleet.paper_report import write_report
+
+    maps50 = args.maps50 or (QUICK_MAPS50 if args.quick else DEFAULT_MAPS50)
+    t0 = time.perf_counter()
+
+    def log(line: str) -> None:
+        if not args.quiet:
+            print(f"[{time.perf_counter() - t0:6.1f} s] {line}", file=sys.stderr, flush=True)
+
+    try:
+        results = run_experiments(Path(args.runs), maps50, log)
+        t1 = time.perf_counter()
+        path = write_report(results, Path(args.out))
+        results.timings["report"] = time.perf_counter() - t1
+        log(f"report and figures written ({time.perf_counter() - t1:.1f} s)")
+    except OSError as err:
+        print(f"agv-fleet paper: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    print(f"{path} ({time.perf_counter() - t0:.1f} s in all)")
+    return EXIT_OK

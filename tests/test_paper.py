@@ -1,0 +1,123 @@
+"""``agv-fleet paper``: the report exists, is complete, and its numbers come from the
+recordings it wrote (not from numbers held aside)."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from recordings.analysis import analyze
+from recordings.plan_metrics import map_plans
+from recordings.reader import open_recording
+
+EXPERIMENTS = ("Table 2", "Table 3", "Fig. 8", "Fig. 9", "Table 4", "Fig. 11", "smoothness")
+
+
+@pytest.fixture(scope="module")
+def paper_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("paper")
+    runs = out / "runs"
+    cmd = [sys.executable, "-m", "fleet.cli", "paper", "--quick", "--out", str(out)]
+    done = subprocess.run([*cmd, "--runs", str(runs)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return out, runs, done
+
+
+def _sections(text: str) -> dict[str, str]:
+    parts = re.split(r"^## ", text, flags=re.M)
+    return {p.split("\n", 1)[0]: p for p in parts[1:]}
+
+
+def _tables(section: str) -> list[list[str]]:
+    """Each Markdown table of a section as its lines."""
+    tables, current = [], []
+    for line in section.splitlines():
+        if line.startswith("|"):
+            current.append(line)
+        elif current:
+            tables.append(current)
+            current = []
+    if current:
+        tables.append(current)
+    return tables
+
+
+def _row(section: str, needle: str) -> list[str]:
+    line = next(x for x in section.splitlines() if x.startswith("|") and needle in x)
+    return [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+
+
+def test_report_names_every_experiment_and_compares_with_the_paper(paper_run):
+    out, _, done = paper_run
+    report = out / "paper-reproduction.md"
+    assert report.is_file()
+    assert "Table 3" in done.stderr and "run 12/12" in done.stderr  # progress lines
+    text = report.read_text()
+    for name in EXPERIMENTS:
+        assert name in text, name
+    tables = [t for s in _sections(text).values() for t in _tables(s)]
+    assert len(tables) >= 7
+    for table in tables:
+        header = table[0].lower()
+        if header.startswith("| map |"):  # Table 2's per-map rows: ours only, paper below
+            continue
+        assert "paper" in header, header
+        assert "ours" in header, header
+    assert "DISAGREES" in text or "Nowhere in direction" in text
+
+
+def test_linked_figures_exist_and_are_small_pngs(paper_run):
+    out, _, _ = paper_run
+    links = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", (out / "paper-reproduction.md").read_text())
+    assert len(links) >= 6
+    for link in links:
+        png = out / link
+        assert png.is_file(), link
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", link
+        assert png.stat().st_size < 150_000, link
+
+
+def test_recordings_are_readable(paper_run):
+    _, runs, _ = paper_run
+    fleet = sorted((runs / "fleet").glob("*.mcap"))
+    plans = sorted((runs / "plans").glob("*.mcap"))
+    assert len(fleet) == 12
+    assert len([p for p in plans if p.name.startswith("table2-")]) == 5
+    assert len([p for p in plans if p.name.startswith("table3-")]) >= 5
+    for path in fleet + plans:
+        rec = open_recording(path)
+        assert not rec.truncated and rec.result is not None, path
+
+
+def test_report_numbers_are_the_analysis_of_the_recordings(paper_run):
+    out, runs, _ = paper_run
+    sections = _sections((out / "paper-reproduction.md").read_text())
+    table4 = next(s for h, s in sections.items() if h.startswith("Table 4"))
+    for algorithm in ("fusion", "astar-dwa"):
+        run = analyze(open_recording(runs / "fleet" / f"paper-dynamic-{algorithm}.mcap"))
+        row = _row(table4, f"paper-dynamic-{algorithm}.mcap")
+        assert row[3] == f"{run.distance:.2f}"
+        assert row[5] == f"{run.run_time:.1f}"
+    smooth = next(s for h, s in sections.items() if h.startswith("Velocity smoothness"))
+    run = analyze(open_recording(runs / "fleet" / "paper-temporary-3-dwa.mcap"))
+    row = _row(smooth, "paper-temporary-3-dwa.mcap")
+    assert row[4] == f"{run.rms_accel:.3f}" and row[5] == f"{run.rms_jerk:.3f}"
+    # Table 2: the per-map row is the metrics of the recorded key nodes
+    table2 = next(s for h, s in sections.items() if h.startswith("Table 2"))
+    path = runs / "plans" / "table2-map20_jsntjyz_graduation.mcap"
+    plans = map_plans(open_recording(path)).plans
+    row = _row(table2, path.name)
+    assert row[1] == f"{plans['traditional'].length:.2f}"
+    assert row[5] == str(plans["improved"].turns)
+
+
+def test_rejects_a_bad_map_count():
+    done = subprocess.run(
+        [sys.executable, "-m", "fleet.cli", "paper", "--maps50", "0"],
+        capture_output=True,
+        text=True,
+    )
+    assert done.returncode == 2 and "must be >= 1" in done.stderr
