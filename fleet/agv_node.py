@@ -107,19 +107,22 @@ class AgvNode:
         return np.array(rows, dtype=float).reshape(-1, 5)
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
-        if plan is None:
-            return None
-        return PlanMsg(
-            name=self.name,
-            tick=tick.tick,
-            time=tick.time,
-            algorithm=plan.algorithm,
-            reason=reason,
-            found=plan.found,
-            path=[list(p) for p in plan.path],
-            key_nodes=[list(p) for p in plan.key_nodes],
-            length=plan.length if plan.found else 0.0,
-            turns=plan.turns if plan.found else 0,
-            turning_angle_deg=plan.turning_angle_deg if plan.found else 0.0,
-            plan_time_ms=plan.time_s * 1e3,
-        )
+        return None if plan is None else plan_message(self.name, tick, plan, reason)
+
+
+def plan_message(name: str, tick: Tick | None, plan: PlanResult, reason: str) -> PlanMsg:
+    """A global plan as published on ``agv/<name>/plan`` (tick None: before any tick)."""
+    return PlanMsg(
+        name=name,
+        tick=tick.tick if tick else 0,
+        time=tick.time if tick else 0.0,
+        algorithm=plan.algorithm,
+        reason=reason,
+        found=plan.found,
+        path=[list(p) for p in plan.path],
+        key_nodes=[list(p) for p in plan.key_nodes],
+        length=plan.length if plan.found else 0.0,
+        turns=plan.turns if plan.found else 0,
+        turning_angle_deg=plan.turning_angle_deg if plan.found else 0.0,
+        plan_time_ms=plan.time_s * 1e3,
+    )

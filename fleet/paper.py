@@ -25,12 +25,12 @@ from pathlib import Path
 import numpy as np
 
 from bridge.keys import WORLD_MAP, agv_plan
-from bridge.messages import PlanMsg
+from fleet.agv_node import plan_message
 from fleet.builtin import bundled_maps
 from fleet.inprocess import run_in_process
 from fleet.scenario import load_scenario, with_algorithm
 from fleet.world import map_message
-from planner.global_planner import PlanResult, plan_global, warm_up
+from planner.global_planner import plan_global, warm_up
 from planner.grid_map import GridMap
 from planner.map_io import load_matrix_text
 from planner.random_map import random_map
@@ -108,23 +108,6 @@ def grid20_maps() -> dict[str, Path]:
     return {n: p for n, p in bundled_maps().items() if n.startswith("map20_")}
 
 
-def _plan_msg(name: str, plan: PlanResult) -> PlanMsg:
-    return PlanMsg(
-        name=name,
-        tick=0,
-        time=0.0,
-        algorithm=plan.algorithm,
-        reason="initial",
-        found=plan.found,
-        path=[list(p) for p in plan.path],
-        key_nodes=[list(p) for p in plan.key_nodes],
-        length=plan.length if plan.found else 0.0,
-        turns=plan.turns if plan.found else 0,
-        turning_angle_deg=plan.turning_angle_deg if plan.found else 0.0,
-        plan_time_ms=plan.time_s * 1e3,
-    )
-
-
 def _scenario_text(name: str, map_table: str, start, goal) -> str:
     """A scenario file with the map and one AGV per algorithm: the planning problem."""
     agvs = "".join(
@@ -148,7 +131,7 @@ def record_plans(path: Path, grid: GridMap, start, goal, name: str, facts: dict,
         found = {}
         for algorithm in PLAN_ALGORITHMS:
             plan = plan_global(grid, start, goal, algorithm)
-            writer.write(agv_plan(algorithm), _plan_msg(algorithm, plan), 0)
+            writer.write(agv_plan(algorithm), plan_message(algorithm, None, plan, "initial"), 0)
             found[algorithm] = plan.found
         writer.finish({"found": found})
 

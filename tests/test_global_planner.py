@@ -7,8 +7,9 @@ import itertools
 import numpy as np
 import pytest
 
+from fleet.paper import corner_free_cell
 from planner.global_planner import plan_global
-from planner.grid_map import GridMap, MapError
+from planner.grid_map import MapError
 from planner.key_nodes import drop_collinear, extract_key_nodes
 from planner.map_io import load_matrix_text, parse_text_grid
 from planner.path_metrics import path_length
@@ -22,17 +23,6 @@ GRID20 = (
     "map20_jsntjyz_graduation.txt",
     "map20_winsleo_commented.txt",
 )
-
-
-def corner_free_cell(grid: GridMap, corner: str):
-    """The free cell nearest to the bottom-left or top-right corner."""
-    rows, cols = np.nonzero(~grid.blocked)
-    if corner == "bottom-left":
-        key = rows + cols
-    else:
-        key = (grid.height - 1 - rows) + (grid.width - 1 - cols)
-    i = int(np.lexsort((cols, key))[0])
-    return int(cols[i]), int(rows[i])
 
 
 def paper_maps(shared_data):
