@@ -89,7 +89,9 @@ def test_two_runs_at_once_do_not_see_each_other(tmp_path):
     # same AGV names and keys, different goals: any cross-talk would change the results
     paths = [_variant(tmp_path, "corridor-a", 1.5), _variant(tmp_path, "corridor-b", 2.5)]
     procs = [
-        subprocess.Popen([*CLI, "run", str(p), "--json", "-q"], stdout=subprocess.PIPE, text=True)
+        subprocess.Popen(
+            [*CLI, "run", str(p), "--json", "-q", "--no-record"], stdout=subprocess.PIPE, text=True
+        )
         for p in paths
     ]
     outputs = [json.loads(p.communicate(timeout=300)[0]) for p in procs]
@@ -154,7 +156,7 @@ def test_malformed_payloads_are_counted_and_ignored():
 
 def test_kill_9_of_an_agv_under_the_launcher():
     proc = subprocess.Popen(
-        [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8"],
+        [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8", "--no-record"],
         stdout=subprocess.PIPE,
         text=True,
     )
@@ -169,7 +171,7 @@ def test_kill_9_of_an_agv_under_the_launcher():
 
 def test_ctrl_c_ends_the_run_and_every_process():
     proc = subprocess.Popen(
-        [*CLI, "run", "warehouse", "--realtime", "1", "-q"],
+        [*CLI, "run", "warehouse", "--realtime", "1", "-q", "--no-record"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

@@ -79,7 +79,17 @@ def test_unreachable_goal_fails_instead_of_driving():
 
 def test_cli_run_json_contract():
     proc = subprocess.run(
-        [sys.executable, "-m", "fleet.cli", "run", "corridor", "--in-process", "--json", "-q"],
+        [
+            sys.executable,
+            "-m",
+            "fleet.cli",
+            "run",
+            "corridor",
+            "--in-process",
+            "--json",
+            "-q",
+            "--no-record",
+        ],
         capture_output=True,
         text=True,
         timeout=300,
@@ -97,7 +107,7 @@ def test_cli_run_json_contract():
 def test_cli_run_exit_status_is_1_when_an_agv_does_not_arrive():
     proc = subprocess.run(
         [sys.executable, "-m", "fleet.cli", "run", "paper-concave", "--in-process",
-         "--algorithm", "dwa", "-q"],
+         "--algorithm", "dwa", "-q", "--no-record"],
         capture_output=True,
         text=True,
         timeout=300,
