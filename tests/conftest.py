@@ -1,4 +1,4 @@
-"""Shared test fixtures: where the public data sets are."""
+"""Shared test fixtures: the public data sets (``tests/data``) and the process check."""
 
 from __future__ import annotations
 
@@ -6,14 +6,15 @@ from pathlib import Path
 
 import pytest
 
-SHARED_DATA = Path(__file__).resolve().parents[2] / "shared" / "data"
+# copies of public maps with their sources (tests/data/README.md): a plain clone needs nothing else
+PUBLIC_DATA = Path(__file__).resolve().parent / "data"
 
 
 @pytest.fixture(scope="session")
-def shared_data() -> Path:
-    if not SHARED_DATA.is_dir():
-        pytest.fail(f"public data sets not found at {SHARED_DATA} (../shared/data)")
-    return SHARED_DATA
+def public_data() -> Path:
+    if not PUBLIC_DATA.is_dir():
+        pytest.fail(f"public data sets not found at {PUBLIC_DATA}")
+    return PUBLIC_DATA
 
 
 @pytest.fixture(autouse=True)

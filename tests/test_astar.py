@@ -13,17 +13,17 @@ from planner.path_metrics import path_length
 SCENARIO_FILES = ("random-32-32-20-random-1.scen", "arena.map.scen")
 
 
-def _scenarios(shared_data):
+def _scenarios(public_data):
     for scen_name in SCENARIO_FILES:
-        scen_path = shared_data / "movingai" / scen_name
+        scen_path = public_data / "movingai" / scen_name
         for entry in load_movingai_scenarios(scen_path):
             yield scen_path.parent / entry.map_name, entry
 
 
-def test_traditional_astar_is_optimal_on_every_movingai_scenario(shared_data):
+def test_traditional_astar_is_optimal_on_every_movingai_scenario(public_data):
     grids = {}
     checked = 0
-    for map_path, e in _scenarios(shared_data):
+    for map_path, e in _scenarios(public_data):
         grid = grids.setdefault(map_path, load_movingai(map_path))
         result = search(grid, (e.start_col, e.start_row), (e.goal_col, e.goal_row))
         assert result.found, (map_path.name, e)
@@ -35,8 +35,8 @@ def test_traditional_astar_is_optimal_on_every_movingai_scenario(shared_data):
     assert checked == 539
 
 
-def test_search_steps_are_unit_moves_without_corner_cutting(shared_data):
-    grid = load_movingai(shared_data / "movingai" / "random-32-32-20.map")
+def test_search_steps_are_unit_moves_without_corner_cutting(public_data):
+    grid = load_movingai(public_data / "movingai" / "random-32-32-20.map")
     rows, cols = np.nonzero(~grid.blocked)  # first and last free cell in row-major order
     result = search(grid, (int(cols[0]), int(rows[0])), (int(cols[-1]), int(rows[-1])))
     assert result.found

@@ -25,10 +25,10 @@ GRID20 = (
 )
 
 
-def paper_maps(shared_data):
+def paper_maps(public_data):
     """The five 20x20 literature maps and 50 seeded 50x50 maps with 20-30 % obstacles."""
     for name in GRID20:
-        grid = load_matrix_text(shared_data / "grid20" / name)
+        grid = load_matrix_text(public_data / "grid20" / name)
         yield name, grid, corner_free_cell(grid, "bottom-left"), corner_free_cell(grid, "top-right")
     seed = made = 0
     while made < 50:
@@ -40,9 +40,9 @@ def paper_maps(shared_data):
             yield f"random-50x50 seed {seed - 1}", grid, (0, 0), (49, 49)
 
 
-def test_improved_never_turns_more_and_keeps_to_free_cells(shared_data):
+def test_improved_never_turns_more_and_keeps_to_free_cells(public_data):
     compared = 0
-    for name, grid, start_cell, goal_cell in paper_maps(shared_data):
+    for name, grid, start_cell, goal_cell in paper_maps(public_data):
         start, goal = grid.centre_of(start_cell), grid.centre_of(goal_cell)
         traditional = plan_global(grid, start, goal, "traditional")
         improved = plan_global(grid, start, goal, "improved")

@@ -64,8 +64,8 @@ def test_bad_text_grid(text, problem):
 
 # --- 0/1 matrices (data/grid20) ----------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(GRID20_OBSTACLES))
-def test_grid20_maps_load_top_row_first(shared_data, name):
-    path = shared_data / "grid20" / name
+def test_grid20_maps_load_top_row_first(public_data, name):
+    path = public_data / "grid20" / name
     as_printed = np.loadtxt(path, comments="#", encoding="utf-8").astype(bool)
     for grid in (load_matrix_text(path, resolution=0.5), load_map(path, resolution=0.5)):
         assert (grid.width, grid.height, grid.resolution) == (20, 20, 0.5)
@@ -74,10 +74,10 @@ def test_grid20_maps_load_top_row_first(shared_data, name):
         assert np.array_equal(grid.blocked[::-1], as_printed)
 
 
-def test_grid20_known_cells(shared_data):
+def test_grid20_known_cells(public_data):
     # First printed row "0 0 0 0 0 0 1 1 1 0 ...",
     # last printed row "0 0 0 0 0 0 0 0 0 0 1 1 0 ...".
-    grid = load_map(shared_data / "grid20" / "map20_classic_aco_xuedidi.txt")
+    grid = load_map(public_data / "grid20" / "map20_classic_aco_xuedidi.txt")
     assert grid.blocked[19, 6] and not grid.blocked[19, 5] and not grid.blocked[0, 6]
     assert grid.blocked[0, 10] and not grid.blocked[19, 10]
     assert grid.is_free((0, 19)) and grid.is_free((19, 0))  # the README's start and goal
@@ -111,8 +111,8 @@ def test_load_map_tells_text_grids_from_matrices(tmp_path):
 
 # --- MovingAI ------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", sorted(MOVINGAI_MAPS))
-def test_movingai_maps(shared_data, name):
-    path = shared_data / "movingai" / name
+def test_movingai_maps(public_data, name):
+    path = public_data / "movingai" / name
     rows = path.read_text().splitlines()[4:]
     as_printed = np.array([[c in "@OTW" for c in row] for row in rows])
     grid = load_map(path)
@@ -121,14 +121,14 @@ def test_movingai_maps(shared_data, name):
     assert np.array_equal(grid.blocked[::-1], as_printed)
 
 
-def test_movingai_known_cells(shared_data):
+def test_movingai_known_cells(public_data):
     # maze-32-32-2: first grid line all '@', second "@..@..@....", last "@.....@.....".
-    grid = load_movingai(shared_data / "movingai" / "maze-32-32-2.map")
+    grid = load_movingai(public_data / "movingai" / "maze-32-32-2.map")
     assert grid.blocked[31].all()
     assert [grid.blocked[30, c] for c in range(4)] == [True, False, False, True]
     assert [grid.blocked[0, c] for c in (0, 1, 6)] == [True, False, True]
     # random-32-32-20 has a single 'T' (tree) among its '@': grid line 18, index 30.
-    grid = load_movingai(shared_data / "movingai" / "random-32-32-20.map")
+    grid = load_movingai(public_data / "movingai" / "random-32-32-20.map")
     assert grid.blocked[31 - 17, 30]
 
 
@@ -162,20 +162,20 @@ def test_bad_movingai_map(tmp_path, content, problem):
         load_map(path)
 
 
-def test_movingai_scenarios_in_the_world_frame(shared_data):
+def test_movingai_scenarios_in_the_world_frame(public_data):
     total = 0
     for scen_name, count in SCENARIOS.items():
-        entries = load_movingai_scenarios(shared_data / "movingai" / scen_name)
+        entries = load_movingai_scenarios(public_data / "movingai" / scen_name)
         assert len(entries) == count
         total += len(entries)
-        grid = load_movingai(shared_data / "movingai" / entries[0].map_name)
+        grid = load_movingai(public_data / "movingai" / entries[0].map_name)
         for e in entries:
             assert (e.width, e.height) == (grid.width, grid.height)
             # Flipped rows would put many starts and goals inside obstacles.
             assert grid.is_free(e.start) and grid.is_free(e.goal), e
     assert total == 539
     # First entry: "7 random-32-32-20.map 32 32 5 16 31 24 31.31370850" (CRLF file).
-    first = load_movingai_scenarios(shared_data / "movingai" / "random-32-32-20-random-1.scen")[0]
+    first = load_movingai_scenarios(public_data / "movingai" / "random-32-32-20-random-1.scen")[0]
     assert (first.bucket, first.map_name) == (7, "random-32-32-20.map")
     assert (first.start, first.goal) == ((5, 31 - 16), (31, 31 - 24))
     assert first.optimal_length == pytest.approx(31.3137085)
@@ -372,8 +372,8 @@ def test_unknown_extension_and_binary_text(tmp_path):
         load_map(path)
 
 
-def test_bad_resolution_names_the_file(shared_data):
-    path = shared_data / "movingai" / "arena.map"
+def test_bad_resolution_names_the_file(public_data):
+    path = public_data / "movingai" / "arena.map"
     with pytest.raises(MapError, match=r"arena\.map: map resolution must be a positive number"):
         load_map(path, resolution=-1.0)
     assert load_map(path, resolution=0.25).size_m == (49 * 0.25, 49 * 0.25)

@@ -124,10 +124,10 @@ def test_duplicate_agv_names_are_rejected():
         parse_scenario(twice)
 
 
-def test_map_file_is_relative_to_the_scenario(tmp_path, shared_data):
+def test_map_file_is_relative_to_the_scenario(tmp_path, public_data):
     maps = tmp_path / "maps"
     maps.mkdir()
-    (maps / "arena.map").write_bytes((shared_data / "movingai" / "arena.map").read_bytes())
+    (maps / "arena.map").write_bytes((public_data / "movingai" / "arena.map").read_bytes())
     scen = tmp_path / "s.toml"
     scen.write_text(
         '[map]\nfile = "maps/arena.map"\n[[agvs]]\nname = "a"\nstart = [3.5, 3.5]\n'
