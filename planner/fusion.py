@@ -35,6 +35,7 @@ from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point
+from planner.profiles import DEFAULT, check_profile
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
@@ -45,6 +46,7 @@ class FusionConfig:
     """Everything one AGV's planner needs; defaults are the paper's."""
 
     algorithm: str = "fusion"
+    profile: str = DEFAULT
     dwa: DwaConfig = field(default_factory=DwaConfig)
     safety_distance: float = DEFAULT_SAFETY_DISTANCE
     switch_distance: float = 1.0
@@ -53,6 +55,7 @@ class FusionConfig:
     progress_distance: float = 0.3
 
     def __post_init__(self) -> None:
+        check_profile(self.profile)
         if self.algorithm not in VARIANTS:
             raise ValueError(
                 f"unknown planner algorithm {self.algorithm!r}: choose one of {', '.join(VARIANTS)}"
