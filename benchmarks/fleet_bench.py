@@ -22,8 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from fleet.inprocess import run_in_process
-from fleet.launcher import FleetOptions, run_fleet
+from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.scenario import load_scenario
 
 WIDTH, HEIGHT = 60, 40

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from bridge import keys
 from bridge.messages import AgvState, MapMsg, Tick, to_dict
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from recordings.analysis import analyze
 from recordings.reader import open_recording

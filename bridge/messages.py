@@ -14,6 +14,8 @@ import types
 import typing
 from dataclasses import dataclass, field
 
+from planner.errors import BadInputError
+
 AGV_STATUSES = ("driving", "arrived", "blocked", "failed")
 
 
@@ -121,7 +123,7 @@ class ResultMsg:
 MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event, ResultMsg)
 
 
-class MessageError(ValueError):
+class MessageError(BadInputError, ValueError):
     """A payload that does not decode to the expected message type."""
 
 

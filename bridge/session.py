@@ -19,6 +19,8 @@ import uuid
 
 import zenoh
 
+from planner.errors import EnvironmentFailure
+
 LEASE_MS = 1000
 CONNECT_ATTEMPT_MS = 500
 # A client (one AGV) needs one thread per Zenoh runtime: with the default pools,
@@ -29,7 +31,7 @@ CLIENT_RUNTIME = (
 )
 
 
-class BusError(RuntimeError):
+class BusError(EnvironmentFailure):
     """The bus could not be opened (bad endpoint or config, no router in time)."""
 
 

@@ -10,8 +10,10 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
+from planner.errors import BadInputError
 
-class ScenarioError(ValueError):
+
+class ScenarioError(BadInputError, ValueError):
     """A scenario file that cannot be used; the message names the key or AGV."""
 
 

@@ -14,11 +14,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planner.errors import BadInputError
+
 Cell = tuple[int, int]
 Point = tuple[float, float]
 
 
-class MapError(ValueError):
+class MapError(BadInputError, ValueError):
     """A map that cannot be read, or a point that does not fit the map."""
 
 

@@ -32,13 +32,14 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import MCAP0_MAGIC
 
 from bridge.keys import agv_name
+from planner.errors import BadInputError
 
 # what mcap raises on a cut or damaged file: its own errors, short reads in struct,
 # CRC mismatches (ValueError), unknown ids (KeyError) and bad compressed data
 _DAMAGED = (McapError, struct.error, ValueError, KeyError, EOFError, zstandard.ZstdError)
 
 
-class RecordingError(Exception):
+class RecordingError(BadInputError):
     """A file that cannot be read as a recording at all (missing, not MCAP)."""
 
 

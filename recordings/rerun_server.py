@@ -23,6 +23,8 @@ from urllib.parse import quote
 
 import rerun_cli
 
+from planner.errors import EnvironmentFailure
+
 RERUN_BINARY = Path(rerun_cli.__file__).with_name("rerun")
 START_TIMEOUT = 20.0
 
@@ -31,7 +33,7 @@ _WEB = re.compile(r"Hosting a web-viewer at http://127\.0\.0\.1:(\d+)")
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
 
 
-class RerunError(RuntimeError):
+class RerunError(EnvironmentFailure):
     """Rerun cannot show it here: no display, no viewer, or a file it cannot write."""
 
 

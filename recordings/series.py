@@ -18,6 +18,7 @@ from operator import itemgetter
 import numpy as np
 
 from bridge import keys
+from planner.errors import BadInputError
 from planner.grid_map import GridMap
 from recordings.reader import Recording, paused_gc
 
@@ -25,7 +26,7 @@ AGV_FIELDS = ("x", "y", "theta", "vx", "vy", "omega", "radius", "plan_time_ms")
 MOVING_FIELDS = ("x", "y", "radius")
 
 
-class SeriesError(ValueError):
+class SeriesError(BadInputError, ValueError):
     """Messages without the fields of agv-fleet messages (not a recording of this tool)."""
 
 

@@ -156,7 +156,7 @@ class RecordingWriter:
 
 
 def record_sink(writer: RecordingWriter, dt: float) -> Callable[[str, object], None]:
-    """A ``fleet.inprocess`` sink that records every message at its simulated time
+    """A ``fleet.runtime.inprocess`` sink that records every message at its simulated time
     (tick * dt; messages without a tick, the map, at 0)."""
     dt_ns = round(dt * 1e9)
     write = writer.write

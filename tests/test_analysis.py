@@ -12,7 +12,7 @@ import pytest
 
 from bridge import keys
 from bridge.messages import AgvState, Event, MapMsg, ObstacleState, PlanMsg, Tick
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from planner.dwa import step_pose
 from recordings.analysis import analyze, compare, world_velocity

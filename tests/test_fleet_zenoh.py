@@ -17,9 +17,9 @@ import pytest
 from bridge import keys
 from bridge.bus import Bus
 from bridge.session import fresh_endpoint, new_run_id, open_client, open_router, run_prefix
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.world_server import WorldServer
 from fleet.scenario import load_scenario
-from fleet.world_process import WorldServer
 from tests.processes import agv_pid, fleet_processes
 
 CLI = [sys.executable, "-m", "fleet.cli"]

@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
-from fleet.paper import corner_free_cell
+from fleet.paper.experiments import corner_free_cell
 from planner.global_planner import plan_global
 from planner.grid_map import MapError
 from planner.key_nodes import drop_collinear, extract_key_nodes

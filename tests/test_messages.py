@@ -20,8 +20,8 @@ from bridge.messages import (
     json_schema,
     to_dict,
 )
+from fleet.runtime.world import World, map_message
 from fleet.scenario import load_scenario
-from fleet.world import World, map_message
 
 STATE = AgvState("a", 3, 1.0, 2.0, 0.5, 0.1, 0.0, -0.02, 0.3, "driving", [4.5, 1.5], 0.2)
 

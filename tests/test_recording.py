@@ -18,7 +18,7 @@ from mcap.reader import make_reader
 from bridge import keys
 from bridge.bus import encode
 from bridge.messages import AgvState, json_schema
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario, parse_scenario
 from recordings.reader import RecordingError, open_recording
 from recordings.writer import (
@@ -270,7 +270,7 @@ def test_default_recording_path_is_under_runs_with_scenario_and_utc_time(tmp_pat
     assert path.name.startswith("paper_temporary_1-") and path.name.endswith("Z.mcap")
 
 
-# --- the command line (needs fleet/cli.py to register fleet.record_commands) ----------
+# --- the command line (needs fleet/cli.py to register fleet.cli.recordings) ----------
 def agv_fleet(*args: str) -> subprocess.CompletedProcess:
     return subprocess.run(
         [sys.executable, "-m", "fleet.cli", *args],

@@ -24,7 +24,7 @@ from rerun.chunk import RrdReader
 
 from bridge.messages import MessageError
 from fleet.builtin import builtin_scenarios
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from recordings.reader import open_recording
 from recordings.rerun_rows import QUANTITIES, RowMaker, blocked_rectangles

@@ -10,7 +10,7 @@ import sys
 import pytest
 
 from fleet.builtin import builtin_scenarios
-from fleet.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario, with_algorithm
 from planner.dwa import DwaConfig
 from planner.fusion import FusionConfig, FusionController

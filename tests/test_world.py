@@ -6,8 +6,8 @@ from dataclasses import replace
 
 import pytest
 
+from fleet.runtime.world import World
 from fleet.scenario import parse_scenario
-from fleet.world import World
 
 SCENARIO = '''
 dt = 0.5

@@ -21,10 +21,10 @@ from pathlib import Path
 
 from bridge.bus import Bus
 from bridge.session import fresh_endpoint, new_run_id, open_router, run_prefix
+from fleet.runtime.summary import RunSummary
+from fleet.runtime.world import World
+from fleet.runtime.world_server import WorldServer
 from fleet.scenario import Scenario
-from fleet.summary import RunSummary
-from fleet.world import World
-from fleet.world_process import WorldServer
 
 EXIT_GRACE_S = 5.0
 
@@ -41,7 +41,7 @@ class FleetOptions:
 
 
 def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: str) -> list[str]:
-    """One host process that forks a process per AGV (see fleet.agv_host)."""
+    """One host process that forks a process per AGV (see fleet.runtime.agv_host)."""
     # -P: import the same installed packages as this process, not a checkout in the cwd
     cmd = [sys.executable, "-P", "-m", "fleet.cli", "agv", options.scenario_arg]
     for name in names:

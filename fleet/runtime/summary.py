@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from fleet.world import World
+from fleet.runtime.world import World
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ import argparse
 import sys
 
 from bridge.messages import MessageError
-from fleet.run_command import positive_float
+from fleet.cli.run import positive_float
 from recordings.reader import RecordingError, open_recording
 from recordings.rerun_view import RerunError, require_display, save_rrd, serve_web, spawn_viewer
 

@@ -11,13 +11,14 @@ import time
 
 from bridge import keys
 from bridge.bus import Bus
-from fleet.agv_node import AgvNode
+from fleet.runtime.agv_node import AgvNode
 from fleet.scenario import Scenario
+from planner.errors import EnvironmentFailure
 
 POLL_S = 0.05
 
 
-class WorldGone(RuntimeError):
+class WorldGone(EnvironmentFailure):
     """The world never appeared, or went away without ending the run."""
 
 

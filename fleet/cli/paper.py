@@ -7,7 +7,8 @@ import sys
 import time
 from pathlib import Path
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+from fleet.cli import exit_codes
+
 DEFAULT_OUT = "paper-report"
 DEFAULT_RUNS = "runs/paper"
 
@@ -57,8 +58,8 @@ def _count(text: str) -> int:
 
 def run_paper(args: argparse.Namespace) -> int:
     # imported here: matplotlib and the experiment code are only needed by this command
-    from fleet.paper import DEFAULT_MAPS50, QUICK_MAPS50, run_experiments
-    from fleet.paper_report import write_report
+    from fleet.paper.experiments import DEFAULT_MAPS50, QUICK_MAPS50, run_experiments
+    from fleet.paper.report import write_report
 
     maps50 = args.maps50 or (QUICK_MAPS50 if args.quick else DEFAULT_MAPS50)
     t0 = time.perf_counter()
@@ -67,14 +68,10 @@ def run_paper(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(f"[{time.perf_counter() - t0:6.1f} s] {line}", file=sys.stderr, flush=True)
 
-    try:
-        results = run_experiments(Path(args.runs), maps50, log)
-        t1 = time.perf_counter()
-        path = write_report(results, Path(args.out))
-        results.timings["report"] = time.perf_counter() - t1
-        log(f"report and figures written ({time.perf_counter() - t1:.1f} s)")
-    except OSError as err:
-        print(f"agv-fleet paper: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    results = run_experiments(Path(args.runs), maps50, log)
+    t1 = time.perf_counter()
+    path = write_report(results, Path(args.out))
+    results.timings["report"] = time.perf_counter() - t1
+    log(f"report and figures written ({time.perf_counter() - t1:.1f} s)")
     print(f"{path} ({time.perf_counter() - t0:.1f} s in all)")
-    return EXIT_OK
+    return exit_codes.OK

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fleet.paper import PaperResults
+from fleet.paper.experiments import PaperResults
 from recordings import paper_plots
 from recordings.plan_metrics import MapPlans
 

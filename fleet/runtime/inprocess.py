@@ -8,10 +8,10 @@ from collections.abc import Callable
 
 from bridge import keys
 from bridge.messages import ResultMsg
-from fleet.agv_node import AgvNode
+from fleet.runtime.agv_node import AgvNode
+from fleet.runtime.summary import RunSummary, summarize
+from fleet.runtime.world import World, map_message
 from fleet.scenario import Scenario
-from fleet.summary import RunSummary, summarize
-from fleet.world import World, map_message
 
 # called with (bus key below the run prefix, message) for every message of the run
 Sink = Callable[[str, object], None]

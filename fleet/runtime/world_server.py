@@ -18,14 +18,15 @@ from collections.abc import Callable
 from bridge import keys
 from bridge.bus import Bus
 from bridge.messages import ResultMsg
+from fleet.runtime.summary import RunSummary, summarize
+from fleet.runtime.world import World, map_message
 from fleet.scenario import Scenario
-from fleet.summary import RunSummary, summarize
-from fleet.world import World, map_message
+from planner.errors import EnvironmentFailure
 
 POLL_S = 0.02
 
 
-class FleetStartError(RuntimeError):
+class FleetStartError(EnvironmentFailure):
     """The run cannot start: the AGV processes failed before tick 0."""
 
 

@@ -19,8 +19,8 @@ import sys
 
 from bridge.bus import Bus
 from bridge.session import BusError, open_client
-from fleet.agv_node import AgvNode
-from fleet.agv_process import WorldGone, serve_agv
+from fleet.runtime.agv_node import AgvNode
+from fleet.runtime.agv_process import WorldGone, serve_agv
 from fleet.scenario import Scenario
 
 _PR_SET_NAME = 15

@@ -25,11 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from bridge.keys import WORLD_MAP, agv_plan
-from fleet.agv_node import plan_message
 from fleet.builtin import bundled_maps
-from fleet.inprocess import run_in_process
+from fleet.runtime.agv_node import plan_message
+from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.world import map_message
 from fleet.scenario import load_scenario, with_algorithm
-from fleet.world import map_message
 from planner.global_planner import plan_global, warm_up
 from planner.grid_map import GridMap
 from planner.map_io import load_matrix_text

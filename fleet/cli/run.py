@@ -8,18 +8,17 @@ import sys
 from contextlib import ExitStack
 from pathlib import Path
 
-from bridge.session import BusError
 from fleet.builtin import builtin_scenarios
-from fleet.inprocess import run_in_process
-from fleet.launcher import FleetOptions, run_fleet
-from fleet.progress import Progress
+from fleet.cli import exit_codes
+from fleet.cli.arguments import UsageError, positive_float
+from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.launcher import FleetOptions, run_fleet
+from fleet.runtime.progress import Progress
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
-from fleet.world_process import FleetStartError
 from planner.fusion import VARIANTS
 from recordings.rerun_view import LiveView, RerunError
 from recordings.writer import RecordingWriter, default_recording_path, record_sink
 
-EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 DEFAULT_SCENARIO = "warehouse"
 
 
@@ -29,7 +28,8 @@ def add_parsers(sub) -> None:
         help="run a scenario (built-in name or TOML file)",
         description=(
             "Run a scenario and print a summary per AGV. Exit 0 only if every AGV "
-            "arrived with no collision, 1 otherwise, 2 for bad input."
+            "arrived with no collision, 1 otherwise, 2 for bad input, 3 when the bus or "
+            "a process failed, 130 when interrupted."
         ),
     )
     p.add_argument(
@@ -96,33 +96,17 @@ def add_parsers(sub) -> None:
     s.set_defaults(handler=list_scenarios)
 
 
-def positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-    return value
-
-
 def run(args: argparse.Namespace) -> int:
-    try:
-        scenario = load_scenario(args.scenario)
-        if args.algorithm:
-            scenario = with_algorithm(scenario, args.algorithm)
-    except ScenarioError as err:
-        print(f"agv-fleet run: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    scenario = load_scenario(args.scenario)
+    if args.algorithm:
+        scenario = with_algorithm(scenario, args.algorithm)
     if args.in_process and args.realtime:
-        print("agv-fleet run: --realtime needs the bus (drop --in-process)", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        raise UsageError("--realtime needs the bus (drop --in-process)")
     record_path = None
     if not args.no_record:
         record_path = Path(args.output) if args.output else default_recording_path(scenario.name)
     if (args.rerun_save or args.rerun_web) and not args.rerun:
-        print("agv-fleet run: --rerun-save and --rerun-web go with --rerun", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        raise UsageError("--rerun-save and --rerun-web go with --rerun")
     progress = None if args.quiet else Progress(scenario)
     with ExitStack() as stack:
         try:
@@ -134,17 +118,13 @@ def run(args: argparse.Namespace) -> int:
             summary = _run(args, scenario, record_path, progress, view)
         except RerunError as err:  # its hints name replay's flags: say run's
             hint = str(err).replace("--save", "--rerun-save").replace("--web", "--rerun-web")
-            print(f"agv-fleet run: {hint}", file=sys.stderr)
-            return EXIT_BAD_INPUT
-        except (BusError, FleetStartError, OSError) as err:
-            print(f"agv-fleet run: {err}", file=sys.stderr)
-            return EXIT_BAD_INPUT
+            raise RerunError(hint) from None
         if record_path:
             print(f"recorded to {record_path}", file=sys.stderr)
         print(json.dumps(summary.to_json()) if args.json else summary.table(), flush=True)
         if view is not None and args.rerun_web:
             view.hold()
-    return EXIT_OK if summary.success else EXIT_FAILED
+    return exit_codes.OK if summary.success else exit_codes.NOT_SUCCEEDED
 
 
 def _run(args, scenario, record_path, progress, view):
@@ -199,4 +179,4 @@ def list_scenarios(args: argparse.Namespace) -> int:
         for name, count, description in rows:
             agvs = f"{count} AGV" + ("s" if count != 1 else "")
             print(f"{name.ljust(width)}  {agvs:>7}  {description}")
-    return EXIT_OK
+    return exit_codes.OK

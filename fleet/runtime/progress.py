@@ -5,8 +5,8 @@ from __future__ import annotations
 import sys
 import time
 
+from fleet.runtime.world import World
 from fleet.scenario import Scenario
-from fleet.world import World
 
 
 class Progress:

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 
 from fleet.builtin import bundled_maps, resolve_map
+from fleet.cli import exit_codes
+from fleet.cli.arguments import UsageError
+from planner.errors import BadInputError
 from planner.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up
-from planner.grid_map import MapError
 from planner.map_io import load_map
 
-EXIT_FOUND, EXIT_BAD_INPUT, EXIT_NO_PATH = 0, 1, 2
 DEFAULT_RADIUS = 0.3
 DEFAULT_MARGIN = 0.2
 
@@ -23,7 +23,7 @@ def add_parser(sub) -> None:
         description=(
             "Plan with traditional and/or improved A* and print length, turning times, "
             "total turning angle, expansions and time. Exit 0 when every plan is found, "
-            "2 when no path exists, 1 on bad input."
+            "1 when no path exists, 2 on bad input."
         ),
         epilog="bundled maps: " + ", ".join(bundled_maps()),
     )
@@ -47,9 +47,9 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     algorithms = ALGORITHMS if args.algorithm == "both" else (args.algorithm,)
+    if args.radius < 0 or args.margin < 0:
+        raise UsageError("--radius and --margin must be >= 0")
     try:
-        if args.radius < 0 or args.margin < 0:
-            raise ValueError("--radius and --margin must be >= 0")
         grid = load_map(resolve_map(args.map), resolution=args.resolution)
         warm_up()
         results = [
@@ -62,15 +62,16 @@ def run(args: argparse.Namespace) -> int:
             )
             for algorithm in algorithms
         ]
-    except (MapError, ValueError) as err:
-        print(f"agv-fleet plan: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    except BadInputError:
+        raise
+    except ValueError as err:  # a setting the planner refuses
+        raise UsageError(str(err)) from None
     if args.json:
         print(json.dumps(plans_json(args.map, args.start, args.goal, results)))
     else:
         print(f"map {grid.name}: {grid.width}x{grid.height} cells at {grid.resolution:g} m")
         print(plans_table(results))
-    return EXIT_FOUND if all(r.found for r in results) else EXIT_NO_PATH
+    return exit_codes.OK if all(r.found for r in results) else exit_codes.NOT_SUCCEEDED
 
 
 def plans_json(map_name: str, start, goal, results: list[PlanResult]) -> dict:

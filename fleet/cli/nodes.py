@@ -9,17 +9,17 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import BusError, open_client, open_router
-from fleet.agv_host import serve_agvs
-from fleet.progress import Progress
-from fleet.recorder_process import serve_recorder
-from fleet.run_command import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, positive_float
-from fleet.scenario import ScenarioError, load_scenario, with_algorithm
-from fleet.world_process import WorldServer
+from bridge.session import open_client, open_router
+from fleet.cli import exit_codes
+from fleet.cli.arguments import positive_float
+from fleet.runtime.agv_host import serve_agvs
+from fleet.runtime.progress import Progress
+from fleet.runtime.recorder_process import serve_recorder
+from fleet.runtime.world_server import WorldServer
+from fleet.scenario import load_scenario, with_algorithm
 from planner.fusion import VARIANTS
 from recordings.writer import RecordingWriter, default_recording_path
 
@@ -106,33 +106,25 @@ def _scenario(args):
 
 
 def run_world(args: argparse.Namespace) -> int:
-    try:
-        scenario, prefix = _scenario(args)
-        with open_router(args.listen, args.zenoh_config) as session:
-            server = WorldServer(
-                scenario,
-                Bus(session, prefix),
-                tick_timeout=args.tick_timeout,
-                start_timeout=args.start_timeout,
-                realtime=args.realtime,
-                progress=None if args.quiet else Progress(scenario),
-            )
-            summary = server.run()
-    except (ScenarioError, BusError) as err:
-        print(f"agv-fleet world: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    scenario, prefix = _scenario(args)
+    with open_router(args.listen, args.zenoh_config) as session:
+        server = WorldServer(
+            scenario,
+            Bus(session, prefix),
+            tick_timeout=args.tick_timeout,
+            start_timeout=args.start_timeout,
+            realtime=args.realtime,
+            progress=None if args.quiet else Progress(scenario),
+        )
+        summary = server.run()
     print(json.dumps(summary.to_json()) if args.json else summary.table())
-    return EXIT_OK if summary.success else EXIT_FAILED
+    return exit_codes.OK if summary.success else exit_codes.NOT_SUCCEEDED
 
 
 def run_agv(args: argparse.Namespace) -> int:
-    try:
-        scenario, prefix = _scenario(args)
-        for name in args.name:
-            scenario.agv(name)
-    except ScenarioError as err:
-        print(f"agv-fleet agv: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    scenario, prefix = _scenario(args)
+    for name in args.name:
+        scenario.agv(name)
     return serve_agvs(
         scenario,
         args.name,
@@ -144,22 +136,16 @@ def run_agv(args: argparse.Namespace) -> int:
 
 
 def run_record(args: argparse.Namespace) -> int:
-    try:
-        scenario, prefix = _scenario(args)
-        path = Path(args.output) if args.output else default_recording_path(scenario.name)
-        facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
-        if args.run_id:
-            facts["run_id"] = args.run_id
-        with (
-            open_client(args.connect, args.connect_timeout, args.zenoh_config) as session,
-            RecordingWriter(
-                path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
-            ) as writer,
-        ):
-            serve_recorder(Bus(session, prefix), writer, scenario.dt)
-    except (ScenarioError, BusError, OSError) as err:
-        print(f"agv-fleet record: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
-        return 130
-    return EXIT_OK
+    scenario, prefix = _scenario(args)
+    path = Path(args.output) if args.output else default_recording_path(scenario.name)
+    facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
+    if args.run_id:
+        facts["run_id"] = args.run_id
+    with (
+        open_client(args.connect, args.connect_timeout, args.zenoh_config) as session,
+        RecordingWriter(
+            path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
+        ) as writer,
+    ):
+        serve_recorder(Bus(session, prefix), writer, scenario.dt)
+    return exit_codes.OK

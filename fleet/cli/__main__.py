@@ -1,0 +1,7 @@
+"""``python -m fleet.cli``: how the launcher starts AGV hosts and the recorder."""
+
+import sys
+
+from fleet.cli.main import main
+
+sys.exit(main())

@@ -1,0 +1,22 @@
+"""Argument types and checks shared by the commands."""
+
+from __future__ import annotations
+
+import argparse
+
+from planner.errors import BadInputError
+
+
+class UsageError(BadInputError):
+    """Options that cannot go together, found after parsing."""
+
+
+def positive_float(text: str) -> float:
+    """An argparse type: a number > 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
