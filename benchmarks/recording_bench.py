@@ -90,7 +90,7 @@ def bench_run(folder: Path) -> None:
     path = folder / "warehouse.mcap"
     t0 = time.perf_counter()
     with writer(path) as w:
-        summary = run_in_process(scenario, sink=record_sink(w, scenario.dt))
+        summary = run_in_process(scenario, outbox=record_sink(w, scenario.dt))
         w.finish(summary.to_json())
     recorded = summary.ticks / (time.perf_counter() - t0)
     messages = len(open_recording(path).records)

@@ -16,8 +16,6 @@ from dataclasses import dataclass, field
 
 from planner.errors import BadInputError
 
-AGV_STATUSES = ("driving", "arrived", "blocked", "failed")
-
 
 @dataclass
 class MapMsg:

@@ -98,10 +98,6 @@ class Scenario:
     source: str
     path: str
 
-    @property
-    def max_ticks(self) -> int:
-        return math.ceil(self.time_limit / self.dt - 1e-9)
-
     def agv(self, name: str) -> AgvSpec:
         for a in self.agvs:
             if a.name == name:

@@ -32,11 +32,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from planner import path_metrics
+from planner.agv_status import FINISHED
 from planner.distance_field import DistanceField
+from planner.motion import world_velocity
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
-
-DONE = ("arrived", "failed")
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ def _agv(
     col = {f: v[rows] for f, v in col.items()}
     status = series.agvs.labels["status"][rows, i]
     time = series.time[rows]
-    done = np.flatnonzero(np.isin(status, DONE))
+    done = np.flatnonzero(np.isin(status, FINISHED))
     end = int(done[0]) if len(done) else len(rows) - 1
     arrived = len(done) > 0 and status[end] == "arrived"
     drive = slice(0, end + 1)
@@ -204,15 +204,6 @@ def _smoothness(col: dict[str, np.ndarray], drive: slice, dt: float | None) -> d
     out["rms_speed_accel"] = _rms(speed_accel)
     out["rms_speed_jerk"] = _rms(np.diff(speed_accel) / dt)
     return out
-
-
-def world_velocity(theta, vx, vy, omega, dt: float) -> np.ndarray:
-    """(n, 2) world-frame velocity of states: each body-frame command (vx, vy) turned by
-    the heading it was applied at, theta - omega*dt (Eq. 4 moves the pose with the
-    heading before the step; this equals the position difference over dt)."""
-    heading = theta - omega * dt
-    c, s = np.cos(heading), np.sin(heading)
-    return np.column_stack((vx * c - vy * s, vx * s + vy * c))
 
 
 def _rms(values: np.ndarray) -> float | None:

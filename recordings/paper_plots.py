@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from planner.grid_map import GridMap
-from recordings.analysis import world_velocity
+from planner.motion import world_velocity
 from recordings.plan_metrics import MapPlans
 from recordings.series import RunSeries
 

@@ -11,7 +11,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from recordings.analysis import world_velocity
+from planner.motion import world_velocity
 from recordings.series import RunSeries
 
 DPI = 100

@@ -32,6 +32,7 @@ import rerun as rr
 
 from bridge import keys
 from bridge.messages import MessageError
+from planner.agv_status import FINISHED
 from recordings import rerun_kinds as kinds
 
 TIMELINE = "sim_time"
@@ -42,7 +43,6 @@ MOVING = "world/moving"
 EVENTS = "events"
 VELOCITY = "velocity"
 QUANTITIES = ("vx", "vy", "speed", "omega")
-DONE = ("arrived", "failed")
 
 # tab10: distinct colours for up to ten AGVs, then they repeat
 PALETTE = (
@@ -220,7 +220,7 @@ class RowMaker:
         vx, vy, omega = data["vx"], data["vy"], data["omega"]
         for q, v in zip(QUANTITIES, (vx, vy, math.hypot(vx, vy), omega)):
             rows.append(Row(velocity_path(q, name), kinds.scalar, t, v))
-        if data["status"] in DONE and name in self._dwa_shown:
+        if data["status"] in FINISHED and name in self._dwa_shown:
             self._dwa_shown.discard(name)
             rows.append(Row(agv_path(name, "dwa"), kinds.strips, t, []))
 

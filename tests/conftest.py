@@ -17,9 +17,16 @@ def public_data() -> Path:
     return PUBLIC_DATA
 
 
+@pytest.fixture(scope="session", autouse=True)
+def _own_descendants():
+    from tests.processes import become_subreaper
+
+    become_subreaper()
+
+
 @pytest.fixture(autouse=True)
 def no_process_left_behind():
-    """After every test, no process of the fleet that the test started is alive (by PID)."""
+    """After every test, no process that the test started is alive (by PID)."""
     from tests.processes import fleet_processes, wait_gone
 
     before = set(fleet_processes())

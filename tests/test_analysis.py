@@ -15,7 +15,8 @@ from bridge.messages import AgvState, Event, MapMsg, ObstacleState, PlanMsg, Tic
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from planner.dwa import step_pose
-from recordings.analysis import analyze, compare, world_velocity
+from planner.motion import world_velocity
+from recordings.analysis import analyze, compare
 from recordings.plots import save_plots
 from recordings.reader import open_recording
 from recordings.report import comparison_table, run_table, to_csv, to_json
@@ -216,7 +217,7 @@ def test_a_real_run_agrees_with_the_worlds_summary(tmp_path):
     with RecordingWriter(
         path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts={}
     ) as writer:
-        summary = run_in_process(scenario, sink=record_sink(writer, scenario.dt))
+        summary = run_in_process(scenario, outbox=record_sink(writer, scenario.dt))
         writer.finish(summary.to_json())
     rec = open_recording(path)
     run = analyze(rec)

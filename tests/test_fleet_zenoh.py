@@ -62,7 +62,7 @@ def test_zenoh_and_in_process_runs_are_identical_tick_by_tick():
         if key.endswith("/state"):
             expected[(msg.tick, msg.name)] = state_key(msg)
 
-    reference = run_in_process(scenario, sink=sink)
+    reference = run_in_process(scenario, outbox=sink)
     with hosted_world("crossing") as (_, bus, server, _):
         states = bus.subscribe("agv/*/state")
         summary = server.run()
@@ -154,15 +154,32 @@ def test_malformed_payloads_are_counted_and_ignored():
     assert result["summary"].to_json()["agvs"] == alone["agvs"]
 
 
-def test_kill_9_of_an_agv_under_the_launcher():
+def _ps_args(pids) -> dict[int, str]:
+    """What ``ps -o args`` shows for ``pids``."""
+    out = subprocess.run(
+        ["ps", "-o", "pid=,args=", "-p", ",".join(map(str, pids))],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+    return {int(pid): args for pid, args in (line.split(None, 1) for line in out.splitlines())}
+
+
+def test_ps_names_each_agv_and_kill_9_of_one_by_name_fails_only_it():
     proc = subprocess.Popen(
         [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8", "--no-record"],
         stdout=subprocess.PIPE,
         text=True,
     )
-    pid = agv_pid("north")
+    agv_pid("north")  # every AGV process is up (north is forked last)
+    shown = _ps_args(fleet_processes())
+    names = ("west", "east", "south", "north")
+    by_name = {
+        n: [pid for pid, args in shown.items() if args == f"agv-fleet agv {n}"] for n in names
+    }
+    assert all(len(pids) == 1 for pids in by_name.values()), shown
     time.sleep(2.0)  # mid-run: the crossing takes ~44 s simulated, ~5.5 s at 8x
-    os.kill(pid, signal.SIGKILL)
+    os.kill(by_name["north"][0], signal.SIGKILL)
     out, _ = proc.communicate(timeout=300)
     assert proc.returncode == 1
     statuses = {a["name"]: a["status"] for a in json.loads(out)["agvs"]}
@@ -220,5 +237,5 @@ def test_an_agv_with_no_world_gives_up_with_one_line():
         text=True,
         timeout=60,
     )  # fmt: skip
-    assert proc.returncode == 2
+    assert proc.returncode == 3  # an environment failure: nothing to connect to
     assert proc.stderr.count("\n") == 1 and "no router" in proc.stderr

@@ -47,7 +47,7 @@ def record_run(path: Path, name: str = "corridor"):
             sunk.append((key, encode(msg)))  # now: the world mutates some objects later
             record(key, msg)
 
-        summary = run_in_process(scenario, sink=sink)
+        summary = run_in_process(scenario, outbox=sink)
         writer.finish(summary.to_json())
     return scenario, summary, sunk
 

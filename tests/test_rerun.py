@@ -82,7 +82,7 @@ def corridor(tmp_path_factory):
             record(key, msg)
             view(key, msg)
 
-        summary = run_in_process(scenario, sink=both)
+        summary = run_in_process(scenario, outbox=both)
         w.finish(summary.to_json())
     return {"mcap": mcap, "live": live, "recording": open_recording(mcap), "dt": scenario.dt}
 

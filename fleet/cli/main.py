@@ -11,7 +11,8 @@ import argparse
 import os
 import sys
 
-from fleet.cli import exit_codes, nodes, paper, plan, recordings, replay, run
+from fleet import exit_codes
+from fleet.cli import nodes, paper, plan, recordings, replay, run
 from planner.errors import AgvFleetError
 
 

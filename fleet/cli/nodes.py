@@ -13,7 +13,7 @@ from pathlib import Path
 
 from bridge.bus import Bus
 from bridge.session import open_client, open_router
-from fleet.cli import exit_codes
+from fleet import exit_codes
 from fleet.cli.arguments import positive_float
 from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.progress import Progress

@@ -7,7 +7,7 @@ import sys
 import time
 from pathlib import Path
 
-from fleet.cli import exit_codes
+from fleet import exit_codes
 
 DEFAULT_OUT = "paper-report"
 DEFAULT_RUNS = "runs/paper"

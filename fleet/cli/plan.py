@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+from fleet import exit_codes
 from fleet.builtin import bundled_maps, resolve_map
-from fleet.cli import exit_codes
 from fleet.cli.arguments import UsageError
 from planner.errors import BadInputError
 from planner.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up

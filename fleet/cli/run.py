@@ -8,16 +8,16 @@ import sys
 from contextlib import ExitStack
 from pathlib import Path
 
+from fleet import exit_codes
 from fleet.builtin import builtin_scenarios
-from fleet.cli import exit_codes
 from fleet.cli.arguments import UsageError, positive_float
-from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.runtime.progress import Progress
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm
 from planner.fusion import VARIANTS
 from recordings.rerun_view import LiveView, RerunError
-from recordings.writer import RecordingWriter, default_recording_path, record_sink
+from recordings.writer import default_recording_path
 
 DEFAULT_SCENARIO = "warehouse"
 
@@ -146,22 +146,7 @@ def _run_in_process(scenario, record_path, algorithm, progress, view):
     if record_path is None:
         return run_in_process(scenario, view, progress)
     facts = {"mode": "in-process", "algorithm": algorithm or "scenario's"}
-    with RecordingWriter(
-        record_path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
-    ) as writer:
-        record = record_sink(writer, scenario.dt)
-        sink = record if view is None else _both(record, view)
-        summary = run_in_process(scenario, sink, progress)
-        writer.finish(summary.to_json())
-    return summary
-
-
-def _both(first, second):
-    def sink(key, msg):
-        first(key, msg)
-        second(key, msg)
-
-    return sink
+    return run_recorded(scenario, record_path, facts, view, progress)
 
 
 def list_scenarios(args: argparse.Namespace) -> int:

@@ -27,7 +27,7 @@ import numpy as np
 from bridge.keys import WORLD_MAP, agv_plan
 from fleet.builtin import bundled_maps
 from fleet.runtime.agv_node import plan_message
-from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.inprocess import run_recorded
 from fleet.runtime.world import map_message
 from fleet.scenario import load_scenario, with_algorithm
 from planner.global_planner import plan_global, warm_up
@@ -38,7 +38,7 @@ from recordings.analysis import RunAnalysis, analyze
 from recordings.plan_metrics import MapPlans, map_plans
 from recordings.reader import open_recording
 from recordings.series import RunSeries, extract
-from recordings.writer import RecordingWriter, record_sink
+from recordings.writer import RecordingWriter
 
 PLAN_ALGORITHMS = ("traditional", "improved")
 RANDOM_SIZE = 50
@@ -178,11 +178,7 @@ def record_fleet_run(fleet_dir: Path, scenario_name: str, algorithm: str) -> Pat
     scenario = with_algorithm(load_scenario(scenario_name), algorithm)
     path = fleet_dir / f"{scenario_name}-{algorithm}.mcap"
     facts = {"mode": "in-process", "algorithm": algorithm, "experiment": "agv-fleet paper"}
-    with RecordingWriter(
-        path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
-    ) as writer:
-        summary = run_in_process(scenario, record_sink(writer, scenario.dt))
-        writer.finish(summary.to_json())
+    run_recorded(scenario, path, facts)
     return path
 
 

@@ -17,13 +17,16 @@ import os
 import signal
 import sys
 
-from bridge.bus import Bus
-from bridge.session import BusError, open_client
-from fleet.runtime.agv_node import AgvNode
-from fleet.runtime.agv_process import WorldGone, serve_agv
-from fleet.scenario import Scenario
+from setproctitle import setproctitle
 
-_PR_SET_NAME = 15
+from bridge.bus import Bus
+from bridge.session import open_client
+from fleet import exit_codes
+from fleet.runtime.agv_node import AgvNode
+from fleet.runtime.agv_process import serve_agv
+from fleet.scenario import Scenario
+from planner.errors import AgvFleetError
+
 _PR_SET_PDEATHSIG = 1
 
 
@@ -39,40 +42,52 @@ def serve_agvs(
     """Run every named AGV, each in its own process; the worst exit status."""
     AgvNode(scenario, names[0]).warm_up()
     if len(names) == 1:
+        setproctitle(process_title(names[0]))
         return _serve_one(scenario, names[0], connect, prefix, connect_timeout, zenoh_config)
     children: dict[int, str] = {}
     for name in names:
         pid = os.fork()
         if pid == 0:  # the child: no Zenoh session exists yet in this process
-            code = 1
+            code = exit_codes.NOT_SUCCEEDED
             try:
                 signal.signal(signal.SIGINT, signal.SIG_DFL)
                 signal.signal(signal.SIGTERM, signal.SIG_DFL)
                 _prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-                _prctl(_PR_SET_NAME, ctypes.c_char_p(f"agv {name}"[:15].encode()))
+                setproctitle(process_title(name))
                 code = _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config)
+            except BaseException as err:  # os._exit below would swallow it silently
+                print(f"agv-fleet agv {name}: crashed: {err!r}", flush=True, file=sys.stderr)
             finally:
                 os._exit(code)
         children[pid] = name
+    setproctitle(f"agv-fleet agv-host {scenario.name} ({len(names)} AGVs)")
     return _wait_for(children)
+
+
+def process_title(name: str) -> str:
+    """How the process of AGV ``name`` reads in ps and top (``pgrep -fx`` finds it)."""
+    return f"agv-fleet agv {name}"
 
 
 def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config) -> int:
     try:
         with open_client(connect, connect_timeout, zenoh_config) as session:
             serve_agv(scenario, name, Bus(session, prefix))
-    except (BusError, WorldGone) as err:
+    except AgvFleetError as err:
         print(f"agv-fleet agv {name}: {err}", flush=True, file=sys.stderr)
-        return 2
+        return exit_codes.for_error(err)
     except KeyboardInterrupt:
-        return 130
-    return 0
+        return exit_codes.INTERRUPTED
+    return exit_codes.OK
 
 
 def _wait_for(children: dict[int, str]) -> int:
     """Wait for every child; on SIGTERM or Ctrl-C end them all by PID first."""
 
+    ending = []
+
     def end_children(signum, frame):
+        ending.append(signum)
         for pid in list(children):
             with contextlib.suppress(ProcessLookupError):
                 os.kill(pid, signal.SIGKILL)
@@ -85,8 +100,10 @@ def _wait_for(children: dict[int, str]) -> int:
             pid, status = os.wait()
         except ChildProcessError:
             break
-        children.pop(pid, None)
+        name = children.pop(pid, None)
         code = os.waitstatus_to_exitcode(status)
+        if code < 0 and not ending:
+            print(f"agv-fleet agv {name}: killed by signal {-code}", flush=True, file=sys.stderr)
         worst = max(worst, 128 - code if code < 0 else code)
     return worst
 

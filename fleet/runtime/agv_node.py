@@ -15,11 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bridge import keys
 from bridge.messages import AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
 from planner.dwa import step_pose
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
+from planner.motion import world_velocity
 
 
 @dataclass
@@ -29,6 +31,17 @@ class NodeOutput:
     state: AgvState
     plan: PlanMsg | None = None
     trajectory: TrajectoryMsg | None = None
+
+
+def publish_output(outbox, out: NodeOutput) -> None:
+    """Send what an AGV says after a tick on its own keys: the same in both run modes
+    (``outbox`` is the bus's ``publish`` or an in-process sink)."""
+    name = out.state.name
+    outbox(keys.agv_state(name), out.state)
+    if out.plan:
+        outbox(keys.agv_plan(name), out.plan)
+    if out.trajectory:
+        outbox(keys.agv_trajectory(name), out.trajectory)
 
 
 class AgvNode:
@@ -101,8 +114,8 @@ class AgvNode:
         for s in tick.agvs:
             if s.name == self.name:
                 continue
-            c, si = math.cos(s.theta), math.sin(s.theta)
-            rows.append([s.x, s.y, s.vx * c - s.vy * si, s.vx * si + s.vy * c, s.radius])
+            vx, vy = world_velocity(s.theta, s.vx, s.vy, s.omega, self.scenario.dt)
+            rows.append([s.x, s.y, vx, vy, s.radius])
         rows.extend([o.x, o.y, o.vx, o.vy, o.radius] for o in tick.moving)
         return np.array(rows, dtype=float).reshape(-1, 5)
 

@@ -11,7 +11,7 @@ import time
 
 from bridge import keys
 from bridge.bus import Bus
-from fleet.runtime.agv_node import AgvNode
+from fleet.runtime.agv_node import AgvNode, publish_output
 from fleet.scenario import Scenario
 from planner.errors import EnvironmentFailure
 
@@ -48,10 +48,5 @@ def serve_agv(scenario: Scenario, name: str, bus: Bus, start_timeout: float = 60
             continue
         if tick.final:
             continue  # the run's end state: the world's token goes next
-        out = node.on_tick(tick)
-        bus.publish(keys.agv_state(name), out.state)
-        if out.plan:
-            bus.publish(keys.agv_plan(name), out.plan)
-        if out.trajectory:
-            bus.publish(keys.agv_trajectory(name), out.trajectory)
+        publish_output(bus.publish, node.on_tick(tick))
         answered += 1

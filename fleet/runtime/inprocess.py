@@ -2,55 +2,54 @@
 
 from __future__ import annotations
 
-import json
-import time
 from collections.abc import Callable
+from pathlib import Path
 
-from bridge import keys
-from bridge.messages import ResultMsg
-from fleet.runtime.agv_node import AgvNode
-from fleet.runtime.summary import RunSummary, summarize
-from fleet.runtime.world import World, map_message
+from bridge.messages import AgvState, Tick
+from fleet.runtime.agv_node import AgvNode, publish_output
+from fleet.runtime.lockstep import Outbox, run_lockstep, tee
+from fleet.runtime.summary import RunSummary
+from fleet.runtime.world import World
 from fleet.scenario import Scenario
+from recordings.writer import RecordingWriter, record_sink
 
-# called with (bus key below the run prefix, message) for every message of the run
-Sink = Callable[[str, object], None]
+
+def _discard(key: str, msg: object) -> None:
+    """The outbox of a run nobody records or watches."""
 
 
 def run_in_process(
     scenario: Scenario,
-    sink: Sink | None = None,
+    outbox: Outbox | None = None,
     progress: Callable[[World], None] | None = None,
 ) -> RunSummary:
-    t0 = time.perf_counter()
-    world = World(scenario)
+    """Run ``scenario`` with every AGV node called directly; every message to ``outbox``."""
+    outbox = outbox or _discard
     nodes = {a.name: AgvNode(scenario, a.name) for a in scenario.agvs}
-    if sink:
-        sink(keys.WORLD_MAP, map_message(scenario.grid))
-    tick = world.first_tick()
-    while tick is not None:
-        if sink:
-            sink(keys.WORLD_TICK, tick)
+
+    def collect(tick: Tick, world: World) -> dict[str, AgvState]:
         replies = {}
         for name in world.live_agvs():
             out = nodes[name].on_tick(tick)
+            publish_output(outbox, out)
             replies[name] = out.state
-            if sink:
-                sink(keys.agv_state(name), out.state)
-                if out.plan:
-                    sink(keys.agv_plan(name), out.plan)
-                if out.trajectory:
-                    sink(keys.agv_trajectory(name), out.trajectory)
-        tick = world.advance(replies)
-        events = world.drain_events()
-        if sink:
-            for event in events:
-                sink(keys.WORLD_EVENT, event)
-            if tick is None:
-                sink(keys.WORLD_TICK, world.final_tick())
-        if progress:
-            progress(world)
-    summary = summarize(world, time.perf_counter() - t0)
-    if sink:
-        sink(keys.WORLD_RESULT, ResultMsg(json.dumps(summary.to_json())))
+        return replies
+
+    return run_lockstep(World(scenario), collect, outbox, after_tick=progress)
+
+
+def run_recorded(
+    scenario: Scenario,
+    path: Path,
+    run_facts: dict,
+    also: Outbox | None = None,
+    progress: Callable[[World], None] | None = None,
+) -> RunSummary:
+    """``run_in_process`` recorded into ``path`` (and every message to ``also``)."""
+    with RecordingWriter(
+        path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=run_facts
+    ) as writer:
+        record = record_sink(writer, scenario.dt)
+        summary = run_in_process(scenario, tee(record, also) if also else record, progress)
+        writer.finish(summary.to_json())
     return summary

@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 from fleet.runtime.world import World
+from planner.agv_status import FINISHED
 
 
 @dataclass(frozen=True)
@@ -87,7 +88,7 @@ def summarize(world: World, wall_time: float) -> RunSummary:
     agvs = []
     for name, r in world.records.items():
         status = r.status
-        if status not in ("arrived", "failed"):
+        if status not in FINISHED:
             status = "timeout" if world.end_reason == "time limit" else status
         agvs.append(
             AgvSummary(

@@ -16,10 +16,9 @@ import numpy as np
 
 from bridge.messages import AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.scenario import Scenario
+from planner.agv_status import FINISHED
 from planner.distance_field import DistanceField
 from planner.grid_map import GridMap
-
-DONE_STATUSES = ("arrived", "failed")
 
 
 @dataclass
@@ -76,7 +75,7 @@ class World:
         return [n for n, r in self.records.items() if r.status != "failed"]
 
     def _running(self) -> list[str]:
-        return [n for n, r in self.records.items() if r.status not in DONE_STATUSES]
+        return [n for n, r in self.records.items() if r.status not in FINISHED]
 
     def advance(self, replies: dict[str, AgvState]) -> Tick | None:
         """Apply every live AGV's state for tick+1; return that tick, or None at the end."""
@@ -91,7 +90,7 @@ class World:
             record.distance += math.hypot(reply.x - old.x, reply.y - old.y)
             reply.tick = self.tick
             self.states[name] = reply
-            if reply.status in DONE_STATUSES and record.status not in DONE_STATUSES:
+            if reply.status in FINISHED and record.status not in FINISHED:
                 self._finish(name, reply.status, reply.status)
         self._refresh_temporary()
         self._check_contacts()
@@ -103,7 +102,7 @@ class World:
 
     def mark_failed(self, name: str, why: str) -> None:
         """An AGV that died or hung: it stays as a stopped obstacle at its last pose."""
-        if self.records[name].status in DONE_STATUSES:
+        if self.records[name].status in FINISHED:
             return
         state = self.states[name]
         state.vx = state.vy = state.omega = 0.0

@@ -10,16 +10,16 @@ stopped obstacle at its last pose; the others go on.
 from __future__ import annotations
 
 import contextlib
-import json
 import queue
 import time
 from collections.abc import Callable
 
 from bridge import keys
 from bridge.bus import Bus
-from bridge.messages import ResultMsg
-from fleet.runtime.summary import RunSummary, summarize
-from fleet.runtime.world import World, map_message
+from bridge.messages import AgvState, Tick
+from fleet.runtime.lockstep import run_lockstep
+from fleet.runtime.summary import RunSummary
+from fleet.runtime.world import World
 from fleet.scenario import Scenario
 from planner.errors import EnvironmentFailure
 
@@ -57,29 +57,19 @@ class WorldServer:
         self._recorder = bus.watch_alive(keys.alive_recorder()) if recorder else None
 
     def run(self) -> RunSummary:
-        t0 = time.perf_counter()
         self._wait_for_agvs()
         self.bus.declare_alive(keys.alive_world())
-        self.bus.publish(keys.WORLD_MAP, map_message(self.scenario.grid))
-        world = self.world
-        tick = world.first_tick()
         paced_from = time.monotonic()
-        while tick is not None:
-            self.bus.publish(keys.WORLD_TICK, tick)
-            replies = self._collect(tick.tick + 1)
-            tick = world.advance(replies)
-            for event in world.drain_events():
-                self.bus.publish(keys.WORLD_EVENT, event)
+
+        def after_tick(world: World) -> None:
             if self.progress:
                 self.progress(world)
-            if self.realtime and tick is not None:
-                delay = paced_from + tick.time / self.realtime - time.monotonic()
+            if self.realtime and not world.ended:
+                delay = paced_from + world.time / self.realtime - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
-        self.bus.publish(keys.WORLD_TICK, world.final_tick())
-        summary = summarize(world, time.perf_counter() - t0)
-        self.bus.publish(keys.WORLD_RESULT, ResultMsg(json.dumps(summary.to_json())))
-        return summary
+
+        return run_lockstep(self.world, self._collect, self.bus.publish, after_tick=after_tick)
 
     def _wait_for_agvs(self) -> None:
         """Every AGV's token before tick 0 (it is declared after its tick subscriber),
@@ -114,9 +104,10 @@ class WorldServer:
         except queue.Empty:
             pass
 
-    def _collect(self, tick: int) -> dict:
-        """Every live AGV's state for ``tick``, until all answered, died or timed out."""
-        replies: dict = {}
+    def _collect(self, tick: Tick, world: World) -> dict[str, AgvState]:
+        """Every live AGV's state for the next tick, until all answered, died or timed out."""
+        replies: dict[str, AgvState] = {}
+        wanted = tick.tick + 1
         deadline = time.monotonic() + self.tick_timeout
         while True:
             self._update_liveliness()
@@ -133,5 +124,5 @@ class WorldServer:
             except queue.Empty:
                 continue
             state = received.msg
-            if state.tick == tick and received.key == keys.agv_state(state.name):
+            if state.tick == wanted and received.key == keys.agv_state(state.name):
                 replies[state.name] = state

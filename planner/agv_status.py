@@ -1,0 +1,9 @@
+"""What an AGV reports each tick, and which of those statuses end its run."""
+
+from __future__ import annotations
+
+DRIVING = "driving"
+BLOCKED = "blocked"  # no admissible command this cycle: braking
+ARRIVED = "arrived"
+FAILED = "failed"
+FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run

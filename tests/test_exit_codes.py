@@ -1,0 +1,102 @@
+"""Every command's exit status for success, failure, bad input, environment failure and
+interrupt: the convention of fleet.exit_codes, as the README's table states it."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+
+import pytest
+
+from fleet import exit_codes
+from fleet.cli.main import main
+from tests.processes import agv_pid
+
+CLI = [sys.executable, "-m", "fleet.cli"]
+OPEN_MAP = "......\n......\n......\n"
+WALLED_MAP = "..#...\n..#...\n..#...\n"
+BROKEN_SCENARIO = 'name = "x"\n[map]\ngrid = """\n....\n"""\n[[agvs]]\nname = "a"\n'
+SHORT_CORRIDOR = (
+    'name = "short"\ntime_limit = 1\n[map]\ngrid = """\n........\n........\n"""\n'
+    '[[agvs]]\nname = "a"\nstart = [0.5, 0.5]\ngoal = [7.5, 0.5]\n'
+)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("inputs")
+    (folder / "open.txt").write_text(OPEN_MAP)
+    (folder / "walled.txt").write_text(WALLED_MAP)
+    (folder / "broken.toml").write_text(BROKEN_SCENARIO)
+    (folder / "short.toml").write_text(SHORT_CORRIDOR)
+    (folder / "not.mcap").write_text("this is not a recording")
+    recording = folder / "corridor.mcap"
+    assert main(["run", "corridor", "--in-process", "-q", "-o", str(recording)]) == 0
+    return folder
+
+
+def _status(argv: list[str]) -> int:
+    """The exit status of ``agv-fleet ARGV`` (argparse's usage errors included)."""
+    try:
+        return main(argv)
+    except SystemExit as done:
+        return done.code
+
+
+PLAN = ["--start", "0.5", "0.5", "--goal", "5.5", "0.5"]
+TABLE = [
+    # (command, outcome, arguments; {d} is the folder of inputs), expected status
+    ("plan", "success", ["plan", "{d}/open.txt", *PLAN], exit_codes.OK),
+    ("plan", "no path", ["plan", "{d}/walled.txt", *PLAN], exit_codes.NOT_SUCCEEDED),
+    ("plan", "missing map", ["plan", "{d}/nothing.txt", *PLAN], exit_codes.BAD_INPUT),
+    ("plan", "bad option", ["plan", "{d}/open.txt", *PLAN, "--radius", "-1"], 2),
+    ("run", "success", ["run", "corridor", "--in-process", "-q", "--no-record"], 0),
+    ("run", "time limit", ["run", "{d}/short.toml", "--in-process", "-q", "--no-record"], 1),
+    ("run", "broken scenario", ["run", "{d}/broken.toml", "--in-process", "--no-record"], 2),
+    ("run", "usage", ["run", "corridor", "--in-process", "--realtime", "2"], 2),
+    ("scenarios", "success", ["scenarios"], exit_codes.OK),
+    ("info", "success", ["info", "{d}/corridor.mcap"], exit_codes.OK),
+    ("info", "not MCAP", ["info", "{d}/not.mcap"], exit_codes.BAD_INPUT),
+    ("analyze", "success", ["analyze", "{d}/corridor.mcap"], exit_codes.OK),
+    ("analyze", "not MCAP", ["analyze", "{d}/not.mcap"], exit_codes.BAD_INPUT),
+    ("replay", "success", ["replay", "{d}/corridor.mcap", "--save", "{d}/c.rrd"], 0),
+    ("replay", "not MCAP", ["replay", "{d}/not.mcap", "--save", "{d}/n.rrd"], 2),
+    ("paper", "bad option", ["paper", "--maps50", "0"], exit_codes.BAD_INPUT),
+    ("world", "cannot listen", ["world", "corridor", "-q", "--listen", "unixsock-stream//no/s"],
+     exit_codes.ENVIRONMENT),
+    ("agv", "no router", ["agv", "corridor", "--name", "left", "--connect", "tcp/127.0.0.1:1",
+                          "--connect-timeout", "0.5"], exit_codes.ENVIRONMENT),
+    ("agv", "unknown AGV", ["agv", "corridor", "--name", "nobody", "--connect", "tcp/127.0.0.1:1"],
+     exit_codes.BAD_INPUT),
+    ("record", "no router", ["record", "corridor", "--connect", "tcp/127.0.0.1:1",
+                             "--connect-timeout", "0.5", "-o", "{d}/r.mcap"], 3),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [pytest.param(argv, code, id=f"{cmd}-{what}") for cmd, what, argv, code in TABLE],
+)
+def test_exit_status(files, capsys, argv, expected):
+    status = _status([a.format(d=files) for a in argv])
+    err = capsys.readouterr().err
+    assert status == expected, err
+    if expected in (exit_codes.BAD_INPUT, exit_codes.ENVIRONMENT):
+        assert err.strip() and "Traceback" not in err
+        assert len(err.strip().splitlines()) == 1 or err.startswith("usage:"), err
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_an_interrupted_run_exits_130_and_says_so(signum):
+    proc = subprocess.Popen(
+        [*CLI, "run", "corridor", "--realtime", "1", "-q", "--no-record"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    agv_pid("right")
+    proc.send_signal(signum)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == exit_codes.INTERRUPTED
+    assert "interrupted" in err and "Traceback" not in err
