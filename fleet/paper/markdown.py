@@ -20,6 +20,10 @@ def fmt_pct(value: float | None) -> str:
     return fmt(value, "{:+.1f} %")
 
 
+def yes_no(flag: bool) -> str:
+    return "yes" if flag else "no"
+
+
 def table(header: list[str], rows: list[list[str]]) -> str:
     def line(cells):  # a "|" inside a cell (|Δω|) would end the cell
         return "| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |"

@@ -9,7 +9,6 @@ from ``fleet.paper.published``; the words from ``fleet/paper/templates/``.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 
 from fleet.paper import markdown as md
@@ -27,12 +26,6 @@ Section = Callable[[PaperResults, Path, Claims], str]
 SECTIONS: tuple[Section, ...] = (table2, table3, fig8, fig9, table4, smoothness)
 
 
-@dataclass(frozen=True)
-class Report:
-    text: str
-    claims: Claims
-
-
 def _paper_run_speed() -> dict[str, str]:
     """Table 4's run times, length and mean speed, as the closing remarks quote them."""
     rows = TABLE4.values()
@@ -45,7 +38,7 @@ def _paper_run_speed() -> dict[str, str]:
     }
 
 
-def build_report(results: PaperResults, figures: Path) -> Report:
+def build_report(results: PaperResults, figures: Path) -> str:
     """The report's text, drawing its figures into ``figures``."""
     claims = Claims()
     sections = [section(results, figures, claims) for section in SECTIONS]
@@ -78,13 +71,12 @@ def build_report(results: PaperResults, figures: Path) -> Report:
         runs_dir=results.runs_dir,
         **_paper_run_speed(),
     )
-    return Report(text + "\n", claims)
+    return text + "\n"
 
 
 def write_report(results: PaperResults, out_dir: Path) -> Path:
     """``out_dir``/paper-reproduction.md and its figures in ``out_dir``/figures."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    report = build_report(results, out_dir / "figures")
     path = out_dir / REPORT_NAME
-    path.write_text(report.text, encoding="utf-8")
+    path.write_text(build_report(results, out_dir / "figures"), encoding="utf-8")
     return path

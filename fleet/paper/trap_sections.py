@@ -41,7 +41,8 @@ def arrived(a: RunAnalysis) -> bool:
 
 
 def arrived_cell(a: RunAnalysis) -> str:
-    return "yes" if arrived(a) else f"no ({a.agvs[0].status})"
+    """yes, or no with the first AGV's final status."""
+    return md.yes_no(True) if arrived(a) else f"{md.yes_no(False)} ({a.agvs[0].status})"
 
 
 def fig8(r: PaperResults, figures: Path, claims: Claims) -> str:
@@ -62,7 +63,7 @@ def fig8(r: PaperResults, figures: Path, claims: Claims) -> str:
     dwa, fusion, hybrid = (run.analysis for run in runs)
     agree = dwa.arrived == 0 and arrived(fusion)
     claims.add(
-        Claim(prose("claim"), FIG8.holds, "yes" if agree else "no", verdict(agree)),
+        Claim(prose("claim"), FIG8.holds, md.yes_no(agree), verdict(agree)),
         prose("disagreement"),
     )
     note = ""
@@ -112,7 +113,7 @@ def fig9(r: PaperResults, figures: Path, claims: Claims) -> str:
         )
     agree = all(arrived(run.analysis) and run.analysis.collisions == 0 for run in runs)
     claims.add(
-        Claim(prose("claim"), FIG9.holds, "yes" if agree else "no", verdict(agree)),
+        Claim(prose("claim"), FIG9.holds, md.yes_no(agree), verdict(agree)),
         prose("disagreement"),
     )
     free = runs[0]
