@@ -311,6 +311,14 @@ class ComparedMetric:
     change_pct: tuple[float | None, ...]  # each run against the first (None: undefined)
 
 
+def percent_change(new: float | None, old: float | None) -> float | None:
+    """How much ``new`` differs from ``old``, in % of ``old`` (None when either is missing or
+    ``old`` is 0)."""
+    if new is None or old is None or old == 0:
+        return None
+    return 100.0 * (new - old) / abs(old)
+
+
 def compare(runs: Sequence[RunAnalysis]) -> list[ComparedMetric]:
     """Run-level metrics side by side with the % difference to the first run (as the
     paper's Table 4 compares algorithms)."""
@@ -318,8 +326,6 @@ def compare(runs: Sequence[RunAnalysis]) -> list[ComparedMetric]:
     for key, label, unit in COMPARED:
         values = tuple(getattr(r, key) for r in runs)
         first = values[0] if values else None
-        change = tuple(
-            None if v is None or not first else 100.0 * (v - first) / abs(first) for v in values
-        )
+        change = tuple(percent_change(v, first) for v in values)
         rows.append(ComparedMetric(key, label, unit, values, change))
     return rows

@@ -3,13 +3,19 @@ recordings it wrote (not from numbers held aside)."""
 
 from __future__ import annotations
 
+import math
 import re
 import subprocess
 import sys
 
 import pytest
 
-from recordings.analysis import analyze
+from fleet.paper import published
+from fleet.paper.markdown import fmt_pct
+from fleet.paper.plan_sections import PLAN_METRICS
+from fleet.paper.prose import Prose, parts
+from fleet.scenario import load_scenario
+from recordings.analysis import analyze, percent_change
 from recordings.plan_metrics import map_plans
 from recordings.reader import open_recording
 
@@ -45,9 +51,12 @@ def _tables(section: str) -> list[list[str]]:
     return tables
 
 
-def _row(section: str, needle: str) -> list[str]:
-    line = next(x for x in section.splitlines() if x.startswith("|") and needle in x)
+def _cells(line: str) -> list[str]:
     return [c.strip() for c in re.split(r"(?<!\\)\|", line)[1:-1]]
+
+
+def _row(section: str, needle: str) -> list[str]:
+    return _cells(next(x for x in section.splitlines() if x.startswith("|") and needle in x))
 
 
 def test_report_names_every_experiment_and_compares_with_the_paper(paper_run):
@@ -112,6 +121,54 @@ def test_report_numbers_are_the_analysis_of_the_recordings(paper_run):
     row = _row(table2, path.name)
     assert row[1] == f"{plans['traditional'].length:.2f}"
     assert row[5] == str(plans["improved"].turns)
+
+
+def test_every_template_placeholder_is_filled(paper_run):
+    out, _, _ = paper_run
+    text = (out / "paper-reproduction.md").read_text()
+    assert "$" not in text and "{" not in text and "}" not in text
+    assert "<!--" not in text  # no template part marker either
+    with pytest.raises(KeyError, match="no value for 'distance'"):
+        Prose("fig8")("hybrid_note", run_time="1")
+
+
+def _paper_cells_from_published() -> list[str]:
+    """The summary's "paper" column, in order, as the published values give it."""
+    cells = []
+    for table in (published.TABLE2, published.TABLE3):
+        for key, _ in PLAN_METRICS:
+            old, new = getattr(table.traditional, key), getattr(table.improved, key)
+            cells.append(fmt_pct(percent_change(new, old)))
+    cells += [published.FIG8.holds, published.FIG9.holds]
+    hybrid, fusion = published.TABLE4["astar-dwa"], published.TABLE4["fusion"]
+    for key in ("path_length", "run_time"):
+        cells.append(fmt_pct(percent_change(getattr(fusion, key), getattr(hybrid, key))))
+    return cells + [published.FIG11.holds] * 4
+
+
+def test_every_claim_compares_with_a_published_value(paper_run):
+    out, _, _ = paper_run
+    summary = _sections((out / "paper-reproduction.md").read_text())["Summary"]
+    rows = [_cells(line) for line in _tables(summary)[0][2:]]
+    assert [row[1] for row in rows] == _paper_cells_from_published()
+    assert all(row[3] in ("agrees", "**DISAGREES**") for row in rows)
+
+
+def test_the_paper_scenarios_run_the_published_motion_limits():
+    """The report says its parameters are the paper's Table 1 and DWA weights."""
+    m = published.MOTION
+    for name in ("paper-concave", "paper-temporary-0", "paper-dynamic"):
+        dwa = load_scenario(name).agvs[0].config.dwa
+        assert (dwa.max_speed, dwa.max_accel) == (m.max_speed, m.max_accel)
+        assert math.isclose(math.degrees(dwa.max_omega), m.max_omega_deg)
+        assert math.isclose(math.degrees(dwa.max_alpha), m.max_alpha_deg)
+        assert (dwa.alpha, dwa.beta, dwa.gamma) == (m.alpha, m.beta, m.gamma)
+
+
+def test_template_parts_are_split_on_their_markers():
+    fig8 = parts("fig8")
+    assert {"body", "caption", "claim", "disagreement", "hybrid_note"} <= set(fig8)
+    assert "<!--" not in fig8["body"].template
 
 
 def test_rejects_a_bad_map_count():

@@ -29,8 +29,9 @@ from fleet.builtin import bundled_maps
 from fleet.runtime.agv_node import plan_message
 from fleet.runtime.inprocess import run_recorded
 from fleet.runtime.world import map_message
-from fleet.scenario import load_scenario, with_algorithm
-from planner.global_planner import plan_global, warm_up
+from fleet.scenario import Scenario, load_scenario, with_algorithm
+from planner.fusion import FusionConfig
+from planner.global_planner import DEFAULT_SAFETY_DISTANCE, plan_global, warm_up
 from planner.grid_map import GridMap
 from planner.map_io import load_matrix_text
 from planner.random_map import random_map
@@ -42,6 +43,8 @@ from recordings.writer import RecordingWriter
 
 PLAN_ALGORITHMS = ("traditional", "improved")
 RANDOM_SIZE = 50
+RANDOM_START = (0.5, 0.5)
+RANDOM_GOAL = (RANDOM_SIZE - 0.5, RANDOM_SIZE - 0.5)
 DEFAULT_MAPS50 = 50
 QUICK_MAPS50 = 5
 # every (scenario, planner variant) run, in order
@@ -70,6 +73,7 @@ class FleetRun:
     recording: Path
     analysis: RunAnalysis
     series: RunSeries
+    spec: Scenario  # as run, with ``algorithm``: the configuration the report quotes
 
 
 @dataclass
@@ -85,6 +89,12 @@ class PaperResults:
 
     def run(self, scenario: str, algorithm: str) -> FleetRun:
         return self.fleet[(scenario, algorithm)]
+
+    @property
+    def config(self) -> FusionConfig:
+        """The planner configuration of the first fleet run; every paper scenario has the
+        same AGV and limits."""
+        return self.run(*FLEET_RUNS[0]).spec.agvs[0].config
 
 
 def random_ratio(seed: int) -> float:
@@ -123,14 +133,22 @@ def _scenario_text(name: str, map_table: str, start, goal) -> str:
 def record_plans(path: Path, grid: GridMap, start, goal, name: str, facts: dict, map_table: str):
     """Plan with both A* variants and record the map and both plans into ``path``."""
     text = _scenario_text(name, map_table, start, goal)
-    run_facts = {"mode": "plan", "map": grid.name, "start": list(start), "goal": list(goal)}
+    run_facts = {
+        "mode": "plan",
+        "map": grid.name,
+        "start": list(start),
+        "goal": list(goal),
+        "safety_distance": DEFAULT_SAFETY_DISTANCE,
+    }
     with RecordingWriter(
         path, scenario_name=name, scenario_text=text, run_facts={**run_facts, **facts}
     ) as writer:
         writer.write(WORLD_MAP, map_message(grid), 0)
         found = {}
         for algorithm in PLAN_ALGORITHMS:
-            plan = plan_global(grid, start, goal, algorithm)
+            plan = plan_global(
+                grid, start, goal, algorithm, safety_distance=DEFAULT_SAFETY_DISTANCE
+            )
             writer.write(agv_plan(algorithm), plan_message(algorithm, None, plan, "initial"), 0)
             found[algorithm] = plan.found
         writer.finish({"found": found})
@@ -153,7 +171,6 @@ def record_grid20(plan_dir: Path, log: Log) -> list[Path]:
 def record_random50(plan_dir: Path, wanted: int, log: Log) -> list[Path]:
     """Seeded 50x50 maps until ``wanted`` of them have a path (at most 20x as many seeds)."""
     paths, made, seed = [], 0, 0
-    start, goal = (0.5, 0.5), (RANDOM_SIZE - 0.5, RANDOM_SIZE - 0.5)
     while made < wanted and seed < 20 * max(wanted, 1):
         ratio = random_ratio(seed)
         corners = [(0, 0), (RANDOM_SIZE - 1, RANDOM_SIZE - 1)]
@@ -164,7 +181,7 @@ def record_random50(plan_dir: Path, wanted: int, log: Log) -> list[Path]:
             f"obstacle_ratio = {ratio:.2f}, seed = {seed} }}\n"
         )
         facts = {"table": 3, "seed": seed, "obstacle_ratio": ratio}
-        record_plans(path, grid, start, goal, f"table3-seed{seed}", facts, table)
+        record_plans(path, grid, RANDOM_START, RANDOM_GOAL, f"table3-seed{seed}", facts, table)
         paths.append(path)
         made += open_recording(path).result["found"]["traditional"]
         seed += 1
@@ -174,9 +191,9 @@ def record_random50(plan_dir: Path, wanted: int, log: Log) -> list[Path]:
     return paths
 
 
-def record_fleet_run(fleet_dir: Path, scenario_name: str, algorithm: str) -> Path:
-    scenario = with_algorithm(load_scenario(scenario_name), algorithm)
-    path = fleet_dir / f"{scenario_name}-{algorithm}.mcap"
+def record_fleet_run(fleet_dir: Path, scenario: Scenario) -> Path:
+    algorithm = scenario.agvs[0].config.algorithm
+    path = fleet_dir / f"{scenario.name}-{algorithm}.mcap"
     facts = {"mode": "in-process", "algorithm": algorithm, "experiment": "agv-fleet paper"}
     run_recorded(scenario, path, facts)
     return path
@@ -197,12 +214,13 @@ def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
     timings["plans"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()
-    fleet_paths = {}
-    for i, (scenario, algorithm) in enumerate(FLEET_RUNS, 1):
+    fleet_paths, scenarios = {}, {}
+    for i, (name, algorithm) in enumerate(FLEET_RUNS, 1):
         t = time.perf_counter()
-        fleet_paths[(scenario, algorithm)] = record_fleet_run(fleet_dir, scenario, algorithm)
+        scenarios[(name, algorithm)] = scenario = with_algorithm(load_scenario(name), algorithm)
+        fleet_paths[(name, algorithm)] = record_fleet_run(fleet_dir, scenario)
         log(
-            f"run {i}/{len(FLEET_RUNS)}: {scenario} with {algorithm} recorded "
+            f"run {i}/{len(FLEET_RUNS)}: {name} with {algorithm} recorded "
             f"({time.perf_counter() - t:.1f} s)"
         )
     timings["fleet"] = time.perf_counter() - t1
@@ -217,7 +235,7 @@ def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
     for key, path in fleet_paths.items():
         rec = open_recording(path)
         series = extract(rec)
-        results.fleet[key] = FleetRun(*key, path, analyze(rec, series), series)
+        results.fleet[key] = FleetRun(*key, path, analyze(rec, series), series, scenarios[key])
     timings["analysis"] = time.perf_counter() - t2
     results.timings = timings
     log(
