@@ -18,9 +18,10 @@ from fleet.agv_host import serve_agvs
 from fleet.progress import Progress
 from fleet.recorder_process import serve_recorder
 from fleet.run_command import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, positive_float
-from fleet.scenario import ScenarioError, load_scenario, with_algorithm
+from fleet.scenario import ScenarioError, load_scenario, with_algorithm, with_profile
 from fleet.world_process import WorldServer
 from planner.fusion import VARIANTS
+from planner.profiles import PROFILES
 from recordings.writer import RecordingWriter, default_recording_path
 
 
@@ -32,6 +33,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
     p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
+    p.add_argument("--profile", choices=PROFILES, help="override the scenario's planner profile")
 
 
 def add_parsers(sub) -> None:
@@ -102,6 +104,8 @@ def _scenario(args):
     scenario = load_scenario(args.scenario)
     if args.algorithm:
         scenario = with_algorithm(scenario, args.algorithm)
+    if args.profile:
+        scenario = with_profile(scenario, args.profile)
     return scenario, args.prefix or f"agv-fleet/{scenario.name}"
 
 
@@ -147,7 +151,12 @@ def run_record(args: argparse.Namespace) -> int:
     try:
         scenario, prefix = _scenario(args)
         path = Path(args.output) if args.output else default_recording_path(scenario.name)
-        facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
+        facts = {
+            "mode": "zenoh",
+            "prefix": prefix,
+            "algorithm": args.algorithm or "scenario's",
+            "profile": args.profile or "scenario's",
+        }
         if args.run_id:
             facts["run_id"] = args.run_id
         with (

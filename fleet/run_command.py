@@ -13,9 +13,10 @@ from fleet.builtin import builtin_scenarios
 from fleet.inprocess import run_in_process
 from fleet.launcher import FleetOptions, run_fleet
 from fleet.progress import Progress
-from fleet.scenario import ScenarioError, load_scenario, with_algorithm
+from fleet.scenario import ScenarioError, load_scenario, with_algorithm, with_profile
 from fleet.world_process import FleetStartError
 from planner.fusion import VARIANTS
+from planner.profiles import PROFILES
 from recordings.rerun_view import LiveView, RerunError
 from recordings.writer import RecordingWriter, default_recording_path, record_sink
 
@@ -48,6 +49,14 @@ def add_parsers(sub) -> None:
         "--algorithm",
         choices=VARIANTS,
         help="plan every AGV with this variant instead of the scenario's",
+    )
+    p.add_argument(
+        "--profile",
+        choices=PROFILES,
+        help=(
+            "plan every AGV with this planner profile instead of the scenario's: default "
+            "(costmap, footprint-safe key nodes) or paper (the paper exactly)"
+        ),
     )
     p.add_argument(
         "--realtime",
@@ -111,6 +120,8 @@ def run(args: argparse.Namespace) -> int:
         scenario = load_scenario(args.scenario)
         if args.algorithm:
             scenario = with_algorithm(scenario, args.algorithm)
+        if args.profile:
+            scenario = with_profile(scenario, args.profile)
     except ScenarioError as err:
         print(f"agv-fleet run: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -149,10 +160,11 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args, scenario, record_path, progress, view):
     if args.in_process:
-        return _run_in_process(scenario, record_path, args.algorithm, progress, view)
+        return _run_in_process(scenario, record_path, args, progress, view)
     options = FleetOptions(
         scenario_arg=str(args.scenario),
         algorithm=args.algorithm,
+        profile=args.profile,
         realtime=args.realtime,
         transport=args.transport,
         zenoh_config=args.zenoh_config,
@@ -162,10 +174,14 @@ def _run(args, scenario, record_path, progress, view):
     return run_fleet(scenario, options, progress=progress, tap=view)
 
 
-def _run_in_process(scenario, record_path, algorithm, progress, view):
+def _run_in_process(scenario, record_path, args, progress, view):
     if record_path is None:
         return run_in_process(scenario, view, progress)
-    facts = {"mode": "in-process", "algorithm": algorithm or "scenario's"}
+    facts = {
+        "mode": "in-process",
+        "algorithm": args.algorithm or "scenario's",
+        "profile": args.profile or "scenario's",
+    }
     with RecordingWriter(
         record_path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
     ) as writer:
