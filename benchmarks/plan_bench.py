@@ -16,6 +16,14 @@ path is checked (8-neighbour steps, free cells, no corner cut under model (a)), 
 every method is timed the same way: wall time of one complete call, median of N runs.
 The script prints PASS/MISS against the issue's targets; it never fails on a MISS.
 
+The costmap case (``--costmap``, also run by default): Nav2's depot map
+(``scenarios/maps/depot.yaml``, 604x307 cells at 0.05 m) for an AGV of radius 0.3 m and
+margin 0.2 m. It times ``Costmap.build`` on the depot and on a 1000x1700 map (5 % random
+obstacles), then, on fixed routes across the depot in its map frame, the search on the
+costmap (``search_costmap``, the default profile) against the present A* on the map's
+obstacle cells (``search``, the paper profile), and the whole ``plan_global`` (search and
+key nodes) of both profiles, with their ratio (target: the costmap search <= 1.5x).
+
 Peers, when installed: cstar-pathfinding ``run_astar_2D`` (C++, corner cutting only),
 tcod ``Pathfinder`` on a ``SimpleGraph`` (corner cutting) or on a ``CustomGraph`` whose
 diagonal edges carry side-cell condition arrays (no corner cutting), and the legacy
@@ -42,11 +50,16 @@ import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
-from planner.astar import search
+from planner.astar import search, search_costmap
+from planner.clearance import Clearance
+from planner.costmap import Costmap
+from planner.global_planner import plan_global
 from planner.grid_map import GridMap
+from planner.map_io import load_map
 
 try:
     import tcod.path as tcod_path
@@ -559,8 +572,12 @@ FIRST_CALL_CODE = """
 import json, time
 import numpy as np
 t0 = time.perf_counter()
-from planner.astar import search
+from planner.astar import search, search_costmap
+from planner.clearance import Clearance
+from planner.costmap import Costmap
+from planner.global_planner import plan_global
 from planner.grid_map import GridMap
+from planner.map_io import load_map
 t1 = time.perf_counter()
 search(GridMap(np.zeros((8, 8), bool)), (0, 0), (7, 7))
 t2 = time.perf_counter()
@@ -727,11 +744,119 @@ def bench_map(name: str, blocked: np.ndarray, runs: int, base_runs: int) -> list
     return [f"{'PASS' if ok else 'MISS'}  [{name}] {text}" for ok, text in lines]
 
 
+# --------------------------------------------------------------------------------------
+# the costmap case
+# --------------------------------------------------------------------------------------
+DEPOT = Path(__file__).resolve().parents[1] / "scenarios" / "maps" / "depot.yaml"
+CLEARANCE = Clearance(0.3, 0.2)
+# routes across the depot, in its map frame (metres): the nav2-depot scenario's and more
+DEPOT_ROUTES = (
+    ((2.0, 13.8), (27.5, 14.0)),
+    ((28.5, 9.3), (2.0, 10.0)),
+    ((1.5, 7.0), (28.0, 7.1)),
+    ((28.5, 4.5), (4.0, 2.5)),
+    ((2.5, 1.2), (28.5, 1.2)),
+    ((28.0, 12.0), (3.0, 5.0)),
+    ((1.0, 1.0), (29.0, 14.0)),
+    ((16.0, 4.3), (27.0, 7.0)),
+)
+
+
+def median_time(fn, runs: int) -> tuple[float, object]:
+    out = fn()  # warm-up (and the result)
+    times = []
+    for _ in range(runs):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def bench_costmap(runs: int) -> list[str]:
+    grid = load_map(DEPOT)
+    print(
+        f"\n=== costmap case: Nav2 depot ({DEPOT.name}), {grid.width}x{grid.height} cells at "
+        f"{grid.resolution:g} m, origin {grid.origin}, AGV radius {CLEARANCE.radius:g} m + "
+        f"margin {CLEARANCE.margin:g} m"
+    )
+    Costmap.build(grid, CLEARANCE)  # compiled or loaded from numba's cache
+    build, costmap = median_time(lambda: Costmap.build(grid, CLEARANCE), runs)
+    big = GridMap(np.random.default_rng(0).random((1000, 1700)) < 0.05, 0.05, "random 1000x1700")
+    build_big, _ = median_time(lambda: Costmap.build(big, CLEARANCE), runs)
+    lethal = float(costmap.lethal.mean())
+    print(
+        f"  costmap build: depot {fmt_ms(build)} ms ({lethal:.1%} of the cells lethal), "
+        f"1000x1700 map with 5 % random obstacles {fmt_ms(build_big)} ms (median of {runs})"
+    )
+    grid.cache[("costmap", CLEARANCE)] = costmap
+    headers = [
+        "route (map frame, m)", "A*", "present ms", "costmap ms", "ratio",
+        "expansions present / costmap", "plan paper ms", "plan default ms", "turns paper / default",
+    ]  # fmt: skip
+    rows, ratios = [], []
+    totals = {"present": 0.0, "costmap": 0.0}
+    for start, goal in DEPOT_ROUTES:
+        s_cell, g_cell = grid.cell_of(start), grid.cell_of(goal)
+        for improved in (False, True):
+            present, r_present = median_time(
+                lambda s=s_cell, g=g_cell, i=improved: search(grid, s, g, improved=i), runs
+            )
+            on_costmap, r_costmap = median_time(
+                lambda s=s_cell, g=g_cell, i=improved: search_costmap(costmap, s, g, improved=i),
+                runs,
+            )
+            algorithm = "improved" if improved else "traditional"
+            plan_paper, p_paper = median_time(
+                lambda s=start, g=goal, a=algorithm: plan_global(grid, s, g, a, profile="paper"),
+                runs,
+            )
+            plan_default, p_default = median_time(
+                lambda s=start, g=goal, a=algorithm: plan_global(
+                    grid, s, g, a, profile="default", clearance=CLEARANCE
+                ),
+                runs,
+            )
+            totals["present"] += present
+            totals["costmap"] += on_costmap
+            ratios.append(on_costmap / present)
+            rows.append(
+                [
+                    f"{start} -> {goal}",
+                    algorithm,
+                    fmt_ms(present),
+                    fmt_ms(on_costmap),
+                    f"{on_costmap / present:.2f}x",
+                    f"{r_present.expansions:,} / {r_costmap.expansions:,}",
+                    fmt_ms(plan_paper),
+                    fmt_ms(plan_default),
+                    f"{p_paper.turns} / {p_default.turns}",
+                ]
+            )
+    print_table(headers, rows, right={2, 3, 4, 5, 6, 7, 8})
+    overall = totals["costmap"] / totals["present"]
+    print(
+        f"  all routes: present A* {fmt_ms(totals['present'])} ms, costmap A* "
+        f"{fmt_ms(totals['costmap'])} ms: {overall:.2f}x (per route: median "
+        f"{statistics.median(ratios):.2f}x, max {max(ratios):.2f}x)"
+    )
+    return [
+        f"{'PASS' if overall <= 1.5 else 'MISS'}  [depot] costmap A* within 1.5x of the present "
+        f"A* on the same routes: {overall:.2f}x (build {fmt_ms(build)} ms)"
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=5, help="timed runs per method (median)")
     parser.add_argument("--baseline-runs", type=int, default=3, help="timed runs of the heapq A*")
+    parser.add_argument(
+        "--costmap", action="store_true", help="only the costmap case on the Nav2 depot map"
+    )
     args = parser.parse_args()
+    if args.costmap:
+        for line in bench_costmap(args.runs):
+            print(f"  {line}")
+        return
 
     print("plan_bench: planner.astar vs a heapq A* and C/C++ peers")
     print(
@@ -759,6 +884,7 @@ def main() -> None:
     verdicts = []
     verdicts += bench_map("random 20 %", random_map(), args.runs, args.baseline_runs)
     verdicts += bench_map("random 20 % + two walls", walls_map(), args.runs, args.baseline_runs)
+    verdicts += bench_costmap(args.runs)
     print(
         "\n=== targets for the traditional A*: within 2x of the fastest C/C++ peer, "
         ">= 10x faster than the heapq A*, optimal length"

@@ -19,13 +19,20 @@ from planner.errors import BadInputError
 
 @dataclass
 class MapMsg:
-    """The static map of a run: rows top to bottom as printed, '.' free, '#' blocked."""
+    """The static map of a run: rows top to bottom as printed, '.' free, '#' blocked.
+
+    ``origin`` [x, y] is the world position of the map's bottom-left corner (the ROS
+    ``map`` frame of a map_server map; [0, 0] for other maps and in recordings made
+    before it existed): cell (col, row), row 0 at the bottom, covers
+    [x + col*resolution, x + (col+1)*resolution) x [y + row*resolution, ...).
+    """
 
     name: str
     width: int
     height: int
     resolution: float
     rows: list[str]
+    origin: list[float] = field(default_factory=lambda: [0.0, 0.0])
 
 
 @dataclass

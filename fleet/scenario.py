@@ -25,17 +25,20 @@ from fleet.toml_schema import (
     get_str,
     get_table,
 )
+from planner.clearance import ClearanceError, clearance_for
+from planner.costmap import point_clearance
 from planner.dwa import DwaConfig
 from planner.fusion import VARIANTS, FusionConfig
 from planner.grid_map import GridMap, MapError
-from planner.map_io import load_map, parse_text_grid
+from planner.map_io import UNKNOWN_CHOICES, load_map, parse_text_grid
+from planner.profiles import DEFAULT, PROFILES
 from planner.random_map import random_map
 
 TOP_KEYS = (
-    "name", "description", "dt", "time_limit", "sensing_radius",
+    "name", "description", "dt", "time_limit", "sensing_radius", "profile",
     "map", "planner", "agv_defaults", "agvs", "obstacles",
 )  # fmt: skip
-MAP_KEYS = ("resolution", "grid", "file", "random")
+MAP_KEYS = ("resolution", "grid", "file", "random", "unknown")
 RANDOM_KEYS = ("width", "height", "obstacle_ratio", "seed")
 # [planner]: TOML key -> (FusionConfig or DwaConfig field, scale to internal units)
 PLANNER_KEYS = {
@@ -49,6 +52,8 @@ PLANNER_KEYS = {
 FUSION_KEYS = (
     "safety_distance", "switch_distance", "goal_tolerance", "progress_window", "progress_distance",
 )  # fmt: skip
+# [planner] margin (m): safety_distance = radius + margin (planner.clearance); one of the two
+CLEARANCE_KEYS = ("margin",)
 # [agv_defaults] and per-AGV keys: TOML key (user units) -> (DwaConfig field, scale)
 VEHICLE_KEYS = {
     "radius": ("radius", 1.0),
@@ -57,7 +62,7 @@ VEHICLE_KEYS = {
     "max_omega": ("max_omega", math.pi / 180),  # deg/s
     "max_alpha": ("max_alpha", math.pi / 180),  # deg/s²
 }
-AGV_KEYS = ("name", "start", "goal", "heading", "planner", *VEHICLE_KEYS)
+AGV_KEYS = ("name", "start", "goal", "heading", "profile", "planner", *VEHICLE_KEYS)
 TEMPORARY_KEYS = ("type", "name", "cells", "appear_at")
 MOVING_KEYS = ("type", "name", "radius", "waypoints", "speed", "mode", "start_at")
 
@@ -137,12 +142,13 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     check_keys(doc, TOP_KEYS, "")
     name = get_str(doc, "name", "", default=path.stem if path else "scenario")
     dt = get_number(doc, "dt", "", default=0.1, positive=True)
+    profile = get_str(doc, "profile", "", default=DEFAULT, choices=PROFILES)
     grid = _parse_map(get_table(doc, "map", "", required=True), path, name, doc)
     planner_defaults = get_table(doc, "planner", "")
     vehicle_defaults = get_table(doc, "agv_defaults", "")
     check_keys(vehicle_defaults, VEHICLE_KEYS, "agv_defaults")
-    _parse_config(planner_defaults, "planner", vehicle_defaults, "agv_defaults", dt)
-    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults)
+    _parse_config(planner_defaults, "planner", vehicle_defaults, "agv_defaults", dt, profile)
+    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile)
     temporary, moving = _parse_obstacles(get_list(doc, "obstacles", "", default=[]), grid)
     return Scenario(
         name=name,
@@ -167,12 +173,14 @@ def _parse_map(table: dict, path: Path | None, name: str, doc: dict) -> GridMap:
     resolution = (
         get_number(table, "resolution", "map", positive=True) if "resolution" in table else None
     )
+    unknown = get_str(table, "unknown", "map", default="obstacle", choices=UNKNOWN_CHOICES)
     try:
         if "grid" in table:
             return parse_text_grid(get_str(table, "grid", "map"), resolution or 1.0, name)
         if "file" in table:
             base = path.parent if path else Path.cwd()
-            return load_map(base / get_str(table, "file", "map"), resolution=resolution)
+            file = base / get_str(table, "file", "map")
+            return load_map(file, resolution=resolution, unknown=unknown)
     except MapError as err:
         raise ScenarioError(f"map: {err}") from None
     spec = get_table(table, "random", "map")
@@ -195,30 +203,52 @@ def _parse_map(table: dict, path: Path | None, name: str, doc: dict) -> GridMap:
 
 
 def _parse_config(
-    planner: dict, planner_where: str, vehicle: dict, vehicle_where: str, dt: float
+    planner: dict,
+    planner_where: str,
+    vehicle: dict,
+    vehicle_where: str,
+    dt: float,
+    profile: str = DEFAULT,
 ) -> FusionConfig:
-    """A FusionConfig from a [planner] table and vehicle keys (user units)."""
+    """A FusionConfig from a [planner] table and vehicle keys (user units).
+
+    The safety distance comes from planner.clearance: ``safety_distance`` or ``margin``
+    (not both), else radius + the default margin; below the radius it is an error."""
     dwa_args: dict = {"dt": dt}
-    fusion_args: dict = {}
-    check_keys(planner, ("algorithm", *PLANNER_KEYS, *FUSION_KEYS), planner_where)
+    fusion_args: dict = {"profile": profile}
+    check_keys(planner, ("algorithm", *PLANNER_KEYS, *FUSION_KEYS, *CLEARANCE_KEYS), planner_where)
+    margin = None
     for key in planner:
         if key == "algorithm":
             fusion_args[key] = get_str(planner, key, planner_where, choices=VARIANTS)
         elif key in PLANNER_KEYS:
             field_name, scale = PLANNER_KEYS[key]
             dwa_args[field_name] = get_number(planner, key, planner_where, positive=True) * scale
+        elif key == "margin":
+            margin = get_number(planner, key, planner_where, minimum=0.0)
         else:
             fusion_args[key] = get_number(planner, key, planner_where, positive=True)
     for key in vehicle:
         field_name, scale = VEHICLE_KEYS[key]
         dwa_args[field_name] = get_number(vehicle, key, vehicle_where, positive=True) * scale
     try:
-        return FusionConfig(dwa=DwaConfig(**dwa_args), **fusion_args)
+        dwa = DwaConfig(**dwa_args)
+        if margin is not None and "safety_distance" in fusion_args:
+            raise ClearanceError(
+                "give safety_distance or margin, not both (safety_distance = radius + margin)"
+            )
+        clearance = clearance_for(
+            dwa.radius, margin=margin, safety_distance=fusion_args.get("safety_distance")
+        )
+        fusion_args["safety_distance"] = clearance.safety_distance
+        return FusionConfig(dwa=dwa, **fusion_args)
     except ValueError as err:
         raise ScenarioError(f"{planner_where}: {err}") from None
 
 
-def _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults) -> tuple[AgvSpec, ...]:
+def _parse_agvs(
+    doc, grid, dt, planner_defaults, vehicle_defaults, profile=DEFAULT
+) -> tuple[AgvSpec, ...]:
     raw = get_list(doc, "agvs", "")
     if not raw:
         raise ScenarioError("a scenario needs at least one [[agvs]] entry")
@@ -237,8 +267,15 @@ def _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults) -> tuple[AgvS
         seen.add(name)
         who = f"AGV {name!r}"
         vehicle = {**vehicle_defaults, **{k: entry[k] for k in VEHICLE_KEYS if k in entry}}
-        planner = {**planner_defaults, **get_table(entry, "planner", where)}
-        config = _parse_config(planner, f"{where}.planner", vehicle, where, dt)
+        own_planner = get_table(entry, "planner", where)
+        defaults = dict(planner_defaults)
+        if "margin" in own_planner or "safety_distance" in own_planner:
+            # the AGV's own clearance replaces the run's, whichever way it is given
+            defaults.pop("margin", None)
+            defaults.pop("safety_distance", None)
+        planner = {**defaults, **own_planner}
+        own_profile = get_str(entry, "profile", where, default=profile, choices=PROFILES)
+        config = _parse_config(planner, f"{where}.planner", vehicle, where, dt, own_profile)
         start = as_point(get_list(entry, "start", where), f"{where}.start")
         goal = as_point(get_list(entry, "goal", where), f"{where}.goal")
         for what, point in (("start", start), ("goal", goal)):
@@ -246,6 +283,12 @@ def _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults) -> tuple[AgvS
                 grid.free_cell_of(point, what)
             except MapError as err:
                 raise ScenarioError(f"{who}: {err}") from None
+            room = point_clearance(grid, point, config.dwa.radius)
+            if room < config.dwa.radius:
+                raise ScenarioError(
+                    f"{who}: {what} ({point[0]:g}, {point[1]:g}) is {room:.3f} m from an obstacle "
+                    f"or the map's edge, less than the AGV radius {config.dwa.radius:g} m"
+                )
         heading = get_number(entry, "heading", where, default=0.0)
         agvs.append(AgvSpec(name, start, goal, heading, config))
     return tuple(agvs)
@@ -292,6 +335,14 @@ def _parse_obstacles(raw: list, grid: GridMap):
                 )
             )
     return tuple(temporary), tuple(moving)
+
+
+def with_profile(scenario: Scenario, profile: str) -> Scenario:
+    """The same scenario with every AGV planning with planner profile ``profile``."""
+    if profile not in PROFILES:
+        raise ScenarioError(f"unknown profile {profile!r}: choose one of {', '.join(PROFILES)}")
+    agvs = tuple(replace(a, config=replace(a.config, profile=profile)) for a in scenario.agvs)
+    return replace(scenario, agvs=agvs)
 
 
 def with_algorithm(scenario: Scenario, algorithm: str) -> Scenario:

@@ -19,6 +19,15 @@ collision check: a node on the map border expands 4 neighbours.
 With the inflated heuristic of the improved variant a closed node is never
 reopened (weighted-A* practice); the path is then not necessarily optimal.
 Ties on f are broken towards the smaller h (deeper nodes first).
+
+``search`` is the paper's search on the map's obstacle cells (profile ``paper``).
+``search_costmap`` is the same search on a costmap (profile ``default``, see
+planner.costmap): the lethal cells take the obstacles' place for moving (no entry,
+no diagonal past one, the hybrid rule's "obstacle among the 4 neighbours"), and a
+step into a cell costs its length times (1 + the cell's penalty). Eq. (3)'s p still
+counts the map's obstacle cells and k the cells of the start-goal rectangle. The
+heuristic stays the Euclidean distance in cells, admissible since penalties are >= 0,
+so the traditional search is optimal on the costmap.
 """
 
 from __future__ import annotations
@@ -30,6 +39,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from planner.costmap import Costmap
 from planner.grid_map import Cell, GridMap
 
 SQRT2 = math.sqrt(2.0)
@@ -75,6 +85,34 @@ def search(
         int(goal[1]),
         improved,
         corner_cutting,
+    )
+    elapsed = time.perf_counter() - t0
+    width = grid.width
+    cells = [(int(i % width), int(i // width)) for i in path]
+    return SearchResult(cells, int(expansions), elapsed)
+
+
+def search_costmap(
+    costmap: Costmap, start: Cell, goal: Cell, *, improved: bool = False
+) -> SearchResult:
+    """A* on a costmap from start to goal cell (col, row). A start or goal inside the
+    lethal band gets an escape out of it (``Costmap.passable``); one in an obstacle cell
+    is a MapError."""
+    grid = costmap.grid
+    for what, cell in (("start", start), ("goal", goal)):
+        if not grid.contains_cell(cell):
+            raise ValueError(f"{what} cell {cell} is outside the map")
+    t0 = time.perf_counter()
+    closed = costmap.passable(start, goal)
+    path, expansions = _astar_costmap(
+        closed,
+        costmap.penalty,
+        grid.prefix_sums,
+        int(start[0]),
+        int(start[1]),
+        int(goal[0]),
+        int(goal[1]),
+        improved,
     )
     elapsed = time.perf_counter() - t0
     width = grid.width
@@ -190,6 +228,94 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
             else:
                 step = 1.0
             ng = g_node + step
+            if ng >= g[nb]:
+                continue
+            g[nb] = ng
+            parent[nb] = node
+            h = math.sqrt(float((gc - cc) ** 2 + (gr - rr) ** 2))
+            if improved:
+                c0 = min(cc, gc)
+                c1 = max(cc, gc)
+                r0 = min(rr, gr)
+                r1 = max(rr, gr)
+                p = (
+                    prefix[r1 + 1, c1 + 1]
+                    - prefix[r0, c1 + 1]
+                    - prefix[r1 + 1, c0]
+                    + prefix[r0, c0]
+                )
+                h = math.exp(p / k) * h
+            heap, size = _heap_push(heap, size, ng + h, h, nb)
+
+    if state[goal] != 2:
+        return np.empty(0, np.int64), expansions
+    length = 1
+    node = goal
+    while node != start:
+        node = parent[node]
+        length += 1
+    path = np.empty(length, np.int64)
+    node = goal
+    for i in range(length - 1, -1, -1):
+        path[i] = node
+        node = parent[node]
+    return path, expansions
+
+
+@numba.njit(cache=True)
+def _astar_costmap(closed, penalty, prefix, sc, sr, gc, gr, improved):
+    """``_astar`` on a costmap: ``closed`` (uint8) is 1 where no step may enter (the
+    lethal cells) and is also the rule's obstacle test; a step into cell n costs its
+    length times (1 + penalty[n])."""
+    height, width = closed.shape
+    n = height * width
+    g = np.full(n, np.inf)
+    parent = np.full(n, -1, np.int32)
+    state = closed.ravel().copy()
+    heap = np.empty((4096, 3), np.float64)
+    size = 0
+    k = float((abs(gc - sc) + 1) * (abs(gr - sr) + 1))
+
+    start = sr * width + sc
+    goal = gr * width + gc
+    g[start] = 0.0
+    h0 = math.sqrt(float((gc - sc) ** 2 + (gr - sr) ** 2))
+    heap, size = _heap_push(heap, size, h0, h0, start)
+    expansions = 0
+    while size > 0:
+        node, size = _heap_pop(heap, size)
+        if state[node] == 2:
+            continue
+        state[node] = 2
+        if node == goal:
+            break
+        expansions += 1
+        r = node // width
+        c = node - r * width
+        g_node = g[node]
+        n_dirs = 8
+        if improved:
+            for d in range(4):
+                cc = c + _DCOL[d]
+                rr = r + _DROW[d]
+                if cc < 0 or cc >= width or rr < 0 or rr >= height or closed[rr, cc]:
+                    n_dirs = 4
+                    break
+        for d in range(n_dirs):
+            cc = c + _DCOL[d]
+            rr = r + _DROW[d]
+            if cc < 0 or cc >= width or rr < 0 or rr >= height:
+                continue
+            nb = rr * width + cc
+            if state[nb] == 1 or state[nb] == 2:
+                continue
+            if d >= 4:
+                if closed[r, cc] or closed[rr, c]:
+                    continue
+                step = SQRT2
+            else:
+                step = 1.0
+            ng = g_node + step * (1.0 + penalty[rr, cc])
             if ng >= g[nb]:
                 continue
             g[nb] = ng

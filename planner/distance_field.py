@@ -13,6 +13,8 @@ between two obstacles, the safe side). Maps too large for MAX_SAMPLES get a
 coarser lattice (at worst one point per cell corner).
 
 The field is 0 inside obstacle cells and outside the map (it is not signed).
+``distance_at`` takes world points (the map's origin is subtracted); the compiled
+``lookup`` takes points relative to the map's bottom-left corner (``origin``).
 """
 
 from __future__ import annotations
@@ -58,6 +60,11 @@ class DistanceField:
         return cls(grid, s, samples)
 
     @property
+    def origin(self) -> tuple[float, float]:
+        """World position of the map's bottom-left corner (the lattice's point (0, 0))."""
+        return self.grid.origin
+
+    @property
     def spacing(self) -> float:
         """Distance between neighbouring lattice points, metres."""
         return self.grid.resolution / self.subdivision
@@ -69,6 +76,9 @@ class DistanceField:
     def distance_at(self, xs, ys) -> np.ndarray:
         """Distance at world points; arrays of any (broadcastable) shape, scalars too."""
         xs, ys = np.broadcast_arrays(np.asarray(xs, dtype=float), np.asarray(ys, dtype=float))
+        ox, oy = self.grid.origin
+        if ox or oy:
+            xs, ys = xs - ox, ys - oy
         out = np.empty(xs.shape)
         _lookup_many(self.samples, 1.0 / self.spacing, xs.ravel(), ys.ravel(), out.reshape(-1))
         return out
@@ -134,7 +144,8 @@ def _squared_edt(obstacle):
 
 @numba.njit(cache=True)
 def lookup(samples, inv_spacing, x, y):
-    """Bilinear lookup at one world point; outside the map (or NaN) gives the border's 0."""
+    """Bilinear lookup at one point relative to the map's bottom-left corner; outside the
+    map (or NaN) gives the border's 0."""
     u = min(max(x * inv_spacing, 0.0), samples.shape[1] - 1.0)
     w = min(max(y * inv_spacing, 0.0), samples.shape[0] - 1.0)
     if not (u == u and w == w):  # NaN

@@ -208,12 +208,12 @@ def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarr
 
 
 @numba.njit(cache=True)
-def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius):
+def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0.0):
     """(N,) minimum over steps of the clearance of trajectories ``xs``, ``ys`` (N, K).
 
-    Static: the distance field minus ``radius``. Moving discs (M, 5) rows
-    [x, y, vx, vy, r], at step k (time (k+1) dt) at constant velocity:
-    centre distance minus r minus ``radius``. A trajectory stops being
+    Static: the distance field (of a map whose origin is (ox, oy)) minus ``radius``.
+    Moving discs (M, 5) rows [x, y, vx, vy, r], at step k (time (k+1) dt) at
+    constant velocity: centre distance minus r minus ``radius``. A trajectory stops being
     evaluated at its first contact (its clearance is then <= 0, which is all
     that matters).
     """
@@ -223,7 +223,7 @@ def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius):
         worst = np.inf
         for k in range(n_steps):
             x, y, t = xs[n, k], ys[n, k], (k + 1) * dt
-            c = lookup(samples, inv_spacing, x, y) - radius
+            c = lookup(samples, inv_spacing, x - ox, y - oy) - radius
             for m in range(moving.shape[0]):
                 dx = x - (moving[m, 0] + moving[m, 2] * t)
                 dy = y - (moving[m, 1] + moving[m, 3] * t)
@@ -339,12 +339,12 @@ class DwaPlanner:
         commands = dynamic_window(cfg, command)
         xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps)
         clearance = min_clearance(
-            xs, ys, field.samples, 1.0 / field.spacing, _NO_DISCS, cfg.dt, cfg.radius
+            xs, ys, field.samples, 1.0 / field.spacing, _NO_DISCS, cfg.dt, cfg.radius, *field.origin
         )
         discs = relevant_discs(cfg, pose, xs, ys, discs, float(clearance.max()))
         if len(discs):
             clearance = min_clearance(
-                xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+                xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
             )
         mask = admissible_mask(cfg, commands, clearance)
         if stop:

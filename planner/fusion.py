@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from planner.clearance import Clearance
+from planner.costmap import Costmap
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
@@ -39,6 +41,8 @@ from planner.profiles import DEFAULT, check_profile
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
+GLOBAL_ALGORITHM = _GLOBAL_ALGORITHM
+"""The global A* variant each planner variant plans with (``dwa`` has none)."""
 
 
 @dataclass(frozen=True)
@@ -63,6 +67,12 @@ class FusionConfig:
         for name in ("safety_distance", "switch_distance", "goal_tolerance", "progress_window"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+        self.clearance  # noqa: B018 - a safety distance below the radius is an error
+
+    @property
+    def clearance(self) -> Clearance:
+        """The AGV's radius (``dwa.radius``) and margin (safety_distance - radius)."""
+        return Clearance.from_safety_distance(self.dwa.radius, self.safety_distance)
 
 
 @dataclass(frozen=True)
@@ -90,6 +100,11 @@ class FusionController:
         self.status = "driving"
         self.failure = ""
         self.dwa = DwaPlanner(self.config.dwa, DistanceField.from_grid(grid))
+        # default profile: the map's costmap for this AGV (shared through the map's cache),
+        # plus the temporary obstacles seen so far
+        self.costmap = None
+        if self.config.profile == DEFAULT:
+            self.costmap = Costmap.for_grid(grid, self.config.clearance)
         self._best_remaining = math.inf
         self._best_time = 0.0
 
@@ -109,14 +124,19 @@ class FusionController:
             self.targets = [self.goal]
             self.target_index = 0
             return None
-        known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
+        if self.costmap is not None:
+            known = self.costmap.grid
+        else:
+            known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
         try:
             plan = plan_global(
                 known,
                 position,
                 self.goal,
                 _GLOBAL_ALGORITHM[self.config.algorithm],
-                safety_distance=self.config.safety_distance,
+                profile=self.config.profile,
+                clearance=self.config.clearance,
+                costmap=self.costmap,
             )
         except MapError as err:  # e.g. standing in a cell now known to be blocked
             plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
@@ -139,6 +159,8 @@ class FusionController:
         if not new:
             return False
         self.known_cells |= new
+        if self.costmap is not None:
+            self.costmap = self.costmap.with_blocked(new)
         self.dwa.distance_field = DistanceField.from_grid(self.grid.with_blocked(self.known_cells))
         return True
 

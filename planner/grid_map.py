@@ -1,10 +1,12 @@
 """Occupancy grid in the world frame of DESIGN.md.
 
-World frame: x right, y up, metres, origin at the map's bottom-left corner
-(ROS REP 103). Cell (col, row), row 0 at the bottom, covers
-[col*res, (col+1)*res) x [row*res, (row+1)*res). The array ``blocked`` is
-indexed ``[row, col]`` with row 0 the bottom row, so ``blocked[::-1]`` is the
-map as printed (top row first).
+World frame: x right, y up, metres (ROS REP 103). ``origin`` (ox, oy) is the
+world position of the map's bottom-left corner: for a ROS map_server map the
+yaml ``origin``, so world coordinates are the ROS ``map`` frame as RViz shows
+them; (0, 0) for text, matrix and MovingAI maps. Cell (col, row), row 0 at the
+bottom, covers [ox + col*res, ox + (col+1)*res) x [oy + row*res, oy + (row+1)*res).
+The array ``blocked`` is indexed ``[row, col]`` with row 0 the bottom row, so
+``blocked[::-1]`` is the map as printed (top row first).
 """
 
 from __future__ import annotations
@@ -31,7 +33,10 @@ class GridMap:
     blocked: np.ndarray
     resolution: float = 1.0
     name: str = "map"
+    origin: tuple[float, float] = (0.0, 0.0)
     _prefix: np.ndarray = field(init=False, repr=False, compare=False)
+    # derived data built once per map (costmaps by clearance): see planner.costmap
+    cache: dict = field(init=False, repr=False, compare=False, default_factory=dict)
 
     def __post_init__(self) -> None:
         blocked = np.ascontiguousarray(self.blocked, dtype=bool)
@@ -39,15 +44,28 @@ class GridMap:
             raise MapError(f"a map needs a non-empty 2-D grid, got shape {blocked.shape}")
         if not (self.resolution > 0 and math.isfinite(self.resolution)):
             raise MapError(f"map resolution must be a positive number, got {self.resolution}")
+        try:
+            origin = tuple(float(v) for v in self.origin)
+        except (TypeError, ValueError):
+            origin = ()
+        if len(origin) != 2 or not all(math.isfinite(v) for v in origin):
+            raise MapError(f"map origin must be two finite numbers (x, y), got {self.origin!r}")
         blocked.setflags(write=False)
         object.__setattr__(self, "blocked", blocked)
+        object.__setattr__(self, "origin", origin)
         object.__setattr__(self, "_prefix", obstacle_prefix_sums(blocked))
 
     # --- construction -----------------------------------------------------------------
     @classmethod
-    def from_rows_top_down(cls, rows: np.ndarray, resolution: float = 1.0, name: str = "map"):
+    def from_rows_top_down(
+        cls,
+        rows: np.ndarray,
+        resolution: float = 1.0,
+        name: str = "map",
+        origin: tuple[float, float] = (0.0, 0.0),
+    ):
         """Build from a grid listed top row first (as text maps and images are printed)."""
-        return cls(np.asarray(rows, dtype=bool)[::-1], resolution, name)
+        return cls(np.asarray(rows, dtype=bool)[::-1], resolution, name, origin)
 
     # --- size -------------------------------------------------------------------------
     @property
@@ -69,24 +87,48 @@ class GridMap:
     def obstacle_ratio(self) -> float:
         return float(self.blocked.mean())
 
+    @property
+    def extent(self) -> tuple[float, float, float, float]:
+        """(x_min, x_max, y_min, y_max) of the map in the world frame, metres."""
+        w, h = self.size_m
+        ox, oy = self.origin
+        return ox, ox + w, oy, oy + h
+
     # --- frames -----------------------------------------------------------------------
     def cell_of(self, point: Point) -> Cell:
         """The (col, row) cell that contains a world point (no bounds check)."""
         return (
-            math.floor(point[0] / self.resolution),
-            math.floor(point[1] / self.resolution),
+            math.floor((point[0] - self.origin[0]) / self.resolution),
+            math.floor((point[1] - self.origin[1]) / self.resolution),
         )
 
     def centre_of(self, cell: Cell) -> Point:
         """World coordinates of a cell's centre."""
-        return ((cell[0] + 0.5) * self.resolution, (cell[1] + 0.5) * self.resolution)
+        return (
+            self.origin[0] + (cell[0] + 0.5) * self.resolution,
+            self.origin[1] + (cell[1] + 0.5) * self.resolution,
+        )
+
+    def to_cell_units(self, point: Point) -> Point:
+        """A world point in cell units: cell (col, row)'s centre is (col, row)."""
+        return (
+            (point[0] - self.origin[0]) / self.resolution - 0.5,
+            (point[1] - self.origin[1]) / self.resolution - 0.5,
+        )
+
+    def from_cell_units(self, point: Point) -> Point:
+        """The world point of a point in cell units (the inverse of ``to_cell_units``)."""
+        return (
+            self.origin[0] + (point[0] + 0.5) * self.resolution,
+            self.origin[1] + (point[1] + 0.5) * self.resolution,
+        )
 
     def contains_cell(self, cell: Cell) -> bool:
         return 0 <= cell[0] < self.width and 0 <= cell[1] < self.height
 
     def contains_point(self, point: Point) -> bool:
-        w, h = self.size_m
-        return 0.0 <= point[0] < w and 0.0 <= point[1] < h
+        x0, x1, y0, y1 = self.extent
+        return x0 <= point[0] < x1 and y0 <= point[1] < y1
 
     def is_free(self, cell: Cell) -> bool:
         """True for a cell inside the map that is not an obstacle."""
@@ -96,10 +138,10 @@ class GridMap:
         """The cell of ``point``; raises MapError naming ``what`` if it is outside or blocked."""
         x, y = point
         if not (math.isfinite(x) and math.isfinite(y)) or not self.contains_point(point):
-            w, h = self.size_m
+            x0, x1, y0, y1 = self.extent
             raise MapError(
                 f"{what} ({x:g}, {y:g}) is outside the map "
-                f"(x in [0, {w:g}), y in [0, {h:g}) metres)"
+                f"(x in [{x0:g}, {x1:g}), y in [{y0:g}, {y1:g}) metres)"
             )
         cell = self.cell_of(point)
         if self.blocked[cell[1], cell[0]]:
@@ -122,7 +164,12 @@ class GridMap:
     def obstacle_centres(self) -> np.ndarray:
         """(N, 2) world coordinates of every obstacle cell's centre."""
         rows, cols = np.nonzero(self.blocked)
-        return np.column_stack(((cols + 0.5) * self.resolution, (rows + 0.5) * self.resolution))
+        return np.column_stack(
+            (
+                self.origin[0] + (cols + 0.5) * self.resolution,
+                self.origin[1] + (rows + 0.5) * self.resolution,
+            )
+        )
 
     def with_blocked(self, cells) -> GridMap:
         """A copy with extra obstacle cells (col, row), e.g. temporary obstacles seen so far."""
@@ -130,7 +177,7 @@ class GridMap:
         for col, row in cells:
             if self.contains_cell((col, row)):
                 blocked[row, col] = True
-        return GridMap(blocked, self.resolution, self.name)
+        return GridMap(blocked, self.resolution, self.name, self.origin)
 
     def to_text(self) -> str:
         """The grid as `.`/`#` rows, top row first."""

@@ -244,9 +244,9 @@ def load_movingai_scenarios(path: str | os.PathLike) -> list[MovingAiScenario]:
 class RosMapInfo:
     """The contents of a ROS map_server YAML file, ``image`` resolved against its folder.
 
-    ``origin`` (x, y, yaw) is the pose of the image's bottom-left pixel in the ROS map
-    frame. GridMap always puts the origin at the bottom-left corner, so load_ros_map drops
-    it; callers that must match ROS coordinates add it back themselves.
+    ``origin`` (x, y, yaw) is the pose of the image's bottom-left pixel in the ROS ``map``
+    frame; load_ros_map makes (x, y) the GridMap's origin, so world coordinates are the
+    ones a ROS user reads in RViz. A non-zero yaw is refused there (see ``check_yaw``).
     """
 
     image: Path
@@ -343,52 +343,116 @@ def _read_pgm(path: str | os.PathLike) -> tuple[np.ndarray, int]:
     return pixels.reshape(height, width), maxval
 
 
-def _ros_blocked(pixels: np.ndarray, maxval: int, info: RosMapInfo) -> np.ndarray:
-    """Blocked cells as map_server would classify them, unknown counted as blocked.
+OCC_FREE, OCC_OCCUPIED, OCC_UNKNOWN = 0, 100, -1  # nav_msgs/OccupancyGrid values
 
-    trinary/scale: occupancy p = (maxval - pixel) / maxval (pixel / maxval if negate);
-    p > occupied_thresh is occupied, p < free_thresh free, anything between is unknown
-    (trinary) or partly occupied (scale). Both count as blocked here, as a planner must
-    not enter unexplored or uncertain space - so only free_thresh decides.
-    raw: the pixel (scaled to 0-255, inverted if negate) is the occupancy in percent,
-    free below free_thresh; values above 100 mean unknown, so they are blocked too.
+
+def ros_occupancy(pixels: np.ndarray, maxval: int, info: RosMapInfo) -> np.ndarray:
+    """The nav_msgs/OccupancyGrid values map_server publishes for these pixels (top row
+    first): 0 free, 100 occupied, -1 unknown, 1-99 partly occupied (nav2_map_server's
+    ``loadMapFromFile``).
+
+    shade = pixel / maxval; occupancy p = 1 - shade (shade if ``negate``).
+    trinary: p > occupied_thresh occupied, p < free_thresh free, anything between unknown.
+    scale: the same, but between the thresholds p is scaled linearly to 1-99 (a PGM has no
+    alpha channel, so nothing is unknown). raw: the value is round(shade * 255) - the
+    occupancy in percent, ``negate`` not applied, as map_server does - and above 100 unknown.
     """
     shade = pixels / maxval
-    if info.negate:
-        shade = 1.0 - shade
     if info.mode == "raw":
-        return np.rint(shade * 255) / 100 >= info.free_thresh
-    return (1.0 - shade) >= info.free_thresh
+        percent = np.rint(shade * 255).astype(np.int16)
+        return np.where(percent <= OCC_OCCUPIED, percent, OCC_UNKNOWN).astype(np.int8)
+    occ = shade if info.negate else 1.0 - shade
+    out = np.full(pixels.shape, OCC_UNKNOWN, dtype=np.int8)
+    if info.mode == "scale":
+        span = max(info.occupied_thresh - info.free_thresh, 1e-12)
+        between = np.rint((occ - info.free_thresh) / span * 100.0)
+        out = np.clip(between, 1, 99).astype(np.int8)
+    out[occ > info.occupied_thresh] = OCC_OCCUPIED
+    out[occ < info.free_thresh] = OCC_FREE
+    return out
 
 
-def load_ros_map(yaml_path: str | os.PathLike, resolution: float | None = None) -> GridMap:
-    """A ROS map_server map (YAML + PGM); the YAML's resolution unless one is given.
+UNKNOWN_CHOICES = ("obstacle", "free")
 
-    The YAML origin is ignored (see :class:`RosMapInfo`).
+
+def ros_blocked(occupancy: np.ndarray, info: RosMapInfo, unknown: str = "obstacle") -> np.ndarray:
+    """Which OccupancyGrid cells a planner must keep out of.
+
+    Occupied (100) always. Partly occupied (1-99), since a planner must not enter
+    uncertain space: in scale mode always (the value lies between the thresholds), in
+    raw mode when the percentage reaches ``free_thresh``. Unknown (-1) unless
+    ``unknown == "free"``: an unexplored area is not known to be empty.
+    """
+    if unknown not in UNKNOWN_CHOICES:
+        raise MapError(
+            f"unknown cells must be one of {', '.join(UNKNOWN_CHOICES)}, got {unknown!r}"
+        )
+    partly = (occupancy > OCC_FREE) & (occupancy < OCC_OCCUPIED)
+    if info.mode == "raw":
+        partly &= occupancy.astype(np.float64) / 100.0 >= info.free_thresh
+    blocked = partly | (occupancy == OCC_OCCUPIED)
+    if unknown == "obstacle":
+        blocked |= occupancy == OCC_UNKNOWN
+    return blocked
+
+
+def check_yaw(info: RosMapInfo, path: Path) -> None:
+    """A rotated map (origin yaw != 0) is refused rather than silently drawn unrotated."""
+    yaw = info.origin[2]
+    if yaw != 0.0:
+        raise MapError(
+            f"{path}: origin yaw {yaw:g} rad is not supported (the map's cells must be "
+            "aligned with the map frame): rotate the image and set the yaw to 0"
+        )
+
+
+def load_ros_map(
+    yaml_path: str | os.PathLike, resolution: float | None = None, unknown: str = "obstacle"
+) -> GridMap:
+    """A ROS map_server map (YAML + PGM) in its ``map`` frame: the YAML's origin (x, y) is
+    the GridMap's origin, and its resolution is used unless one is given. ``unknown``:
+    whether unknown cells are obstacles (default) or free (see :func:`ros_blocked`).
     """
     path = Path(yaml_path)
     info = read_ros_map_info(path)
+    check_yaw(info, path)
+    if unknown not in UNKNOWN_CHOICES:
+        raise MapError(
+            f"{path}: unknown cells must be one of {', '.join(UNKNOWN_CHOICES)}, got {unknown!r}"
+        )
     if not info.image.is_file():
         raise MapError(f"{path}: map image not found: {info.image}")
     pixels, maxval = _read_pgm(info.image)
-    blocked = _ros_blocked(pixels, maxval, info)
-    return _grid(blocked, info.resolution if resolution is None else resolution, path)
+    blocked = ros_blocked(ros_occupancy(pixels, maxval, info), info, unknown)
+    res = info.resolution if resolution is None else resolution
+    try:
+        return GridMap.from_rows_top_down(blocked, res, path.stem, info.origin[:2])
+    except MapError as err:
+        raise MapError(f"{path}: {err}") from None
 
 
 # --- any file --------------------------------------------------------------------------
-def load_map(path: str | os.PathLike, resolution: float | None = None) -> GridMap:
+def load_map(
+    path: str | os.PathLike, resolution: float | None = None, unknown: str = "obstacle"
+) -> GridMap:
     """Load a map, choosing the reader by extension.
 
     ``.map`` MovingAI, ``.yaml``/``.yml`` ROS map_server, ``.txt``/``.grid`` a 0/1 matrix
     or a '.'/'#' grid (told apart by content). ``resolution`` defaults to 1.0, or to the
-    YAML's value for ROS maps.
+    YAML's value for ROS maps. ROS maps keep their origin (the ``map`` frame) and their
+    unknown cells are obstacles unless ``unknown="free"``; the other formats have their
+    origin at (0, 0) and no unknown cells.
     """
     path = Path(path)
     if not path.exists():
         raise MapError(f"map file not found: {path}")
+    if unknown not in UNKNOWN_CHOICES:
+        raise MapError(
+            f"unknown cells must be one of {', '.join(UNKNOWN_CHOICES)}, got {unknown!r}"
+        )
     suffix = path.suffix.lower()
     if suffix in (".yaml", ".yml"):
-        return load_ros_map(path, resolution)
+        return load_ros_map(path, resolution, unknown)
     res = 1.0 if resolution is None else resolution
     if suffix == ".map":
         return load_movingai(path, res)

@@ -43,13 +43,13 @@ def _panels(count: int, columns: int, size: float = 3.0):
 def _draw_map(ax, grid: GridMap | None) -> None:
     if grid is None:
         return
-    width, height = grid.size_m
+    x0, x1, y0, y1 = grid.extent
     ax.imshow(
-        grid.blocked, origin="lower", extent=(0, width, 0, height), cmap="Greys",
+        grid.blocked, origin="lower", extent=(x0, x1, y0, y1), cmap="Greys",
         vmin=0, vmax=1.4, interpolation="nearest",
     )  # fmt: skip
-    ax.set_xlim(0, width)
-    ax.set_ylim(0, height)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
     ax.tick_params(labelsize="x-small")
 
@@ -90,9 +90,12 @@ def spread_figure(values: dict[str, dict[str, list[float]]], labels: dict[str, s
 def _temporary_cells(ax, series: RunSeries) -> None:
     if series.grid is None:
         return
-    res = series.grid.resolution
+    grid = series.grid
+    res = grid.resolution
     for col, row in sorted({c for shown in series.temporary for c in shown}):
-        ax.add_patch(Rectangle((col * res, row * res), res, res, color="tab:orange", alpha=0.8))
+        cx, cy = grid.centre_of((col, row))
+        corner = (cx - res / 2, cy - res / 2)
+        ax.add_patch(Rectangle(corner, res, res, color="tab:orange", alpha=0.8))
 
 
 def trajectories_figure(

@@ -11,12 +11,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from bridge.keys import WORLD_MAP, agv_plan
 from planner import path_metrics
 from planner.grid_map import GridMap
 from recordings.reader import Recording
+from recordings.series import map_grid
 
 
 @dataclass(frozen=True)
@@ -76,13 +75,7 @@ def map_plans(rec: Recording, algorithms=("traditional", "improved")) -> MapPlan
     return MapPlans(
         path=str(rec.path),
         map_name=str(grid.get("name", "")),
-        grid=_grid(grid) if grid else None,
+        grid=map_grid(grid) if grid else None,
         facts=rec.run,
         plans=plans,
     )
-
-
-def _grid(msg: dict) -> GridMap:
-    cells = np.frombuffer("".join(msg["rows"]).encode(), dtype=np.uint8)
-    blocked = cells.reshape(msg["height"], msg["width"]) == ord("#")
-    return GridMap.from_rows_top_down(blocked, msg["resolution"], msg["name"])

@@ -37,15 +37,16 @@ def _save(figure: Figure, path: Path) -> Path:
 def _map_figure(series: RunSeries) -> Figure:
     grid = series.grid
     width, height = grid.size_m if grid else (10.0, 10.0)
+    x0, x1, y0, y1 = grid.extent if grid else (0.0, width, 0.0, height)
     scale = 8.0 / max(width, height)
     figure = Figure(figsize=(max(4.0, width * scale) + 2.5, max(3.0, height * scale) + 0.8))
     ax = figure.add_subplot()
     if grid is not None:
         ax.imshow(
-            grid.blocked, origin="lower", extent=(0, width, 0, height), cmap="Greys",
+            grid.blocked, origin="lower", extent=(x0, x1, y0, y1), cmap="Greys",
             vmin=0, vmax=1.4, interpolation="nearest",
         )  # fmt: skip
-        _temporary_cells(ax, series, grid.resolution)
+        _temporary_cells(ax, series)
     mov = series.moving.columns
     for m in range(len(series.moving.names)):
         ax.plot(mov["x"][:, m], mov["y"][:, m], color="tab:gray", lw=0.8, ls="--")
@@ -63,8 +64,8 @@ def _map_figure(series: RunSeries) -> Figure:
         ax.plot(x, y, color=colour, lw=1.6, label=name)
         if len(x):
             ax.plot(x[0], y[0], "s", color=colour, ms=5)
-    ax.set_xlim(0, width)
-    ax.set_ylim(0, height)
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -75,11 +76,14 @@ def _map_figure(series: RunSeries) -> Figure:
     return figure
 
 
-def _temporary_cells(ax, series: RunSeries, resolution: float) -> None:
+def _temporary_cells(ax, series: RunSeries) -> None:
     """Every temporary obstacle cell shown during the run, as orange squares."""
+    grid = series.grid
+    res = grid.resolution
     for col, row in sorted({c for shown in series.temporary for c in shown}):
-        square = (col * resolution, row * resolution)
-        ax.add_patch(Rectangle(square, resolution, resolution, color="tab:orange", alpha=0.8))
+        cx, cy = grid.centre_of((col, row))
+        square = (cx - res / 2, cy - res / 2)
+        ax.add_patch(Rectangle(square, res, res, color="tab:orange", alpha=0.8))
 
 
 def _velocity_figure(series: RunSeries, i: int) -> Figure:

@@ -78,7 +78,7 @@ def _extract(rec: Recording) -> RunSeries:
         tick, time, agvs, moving, temporary = _from_ticks(rec)
     names = list(dict.fromkeys([*agvs.names, *rec.agv_names()]))
     return RunSeries(
-        grid=_grid(maps[0].data) if maps else None,
+        grid=map_grid(maps[0].data) if maps else None,
         tick=tick,
         time=time,
         agvs=agvs,
@@ -103,10 +103,14 @@ def _from_ticks(rec: Recording):
     )
 
 
-def _grid(msg: dict) -> GridMap:
+def map_grid(msg: dict) -> GridMap:
+    """The GridMap of a decoded ``world/map`` message (``MapMsg``), in the run's world
+    frame: its origin honoured (absent in older recordings: (0, 0)). The one place that
+    turns a map message back into a map."""
     cells = np.frombuffer("".join(msg["rows"]).encode(), dtype=np.uint8)
     blocked = cells.reshape(msg["height"], msg["width"]) == ord("#")
-    return GridMap.from_rows_top_down(blocked, msg["resolution"], msg["name"])
+    origin = tuple(msg.get("origin") or (0.0, 0.0))
+    return GridMap.from_rows_top_down(blocked, msg["resolution"], msg["name"], origin)
 
 
 def _discs(per_tick: list[list[dict]], fields: tuple[str, ...], text: tuple[str, ...]) -> Discs:

@@ -35,7 +35,7 @@ def paper_maps(public_data):
         ratio = 0.20 + 0.10 * (seed % 11) / 10
         grid = random_map(50, 50, ratio, seed, keep_free=[(0, 0), (49, 49)])
         seed += 1
-        if plan_global(grid, (0.5, 0.5), (49.5, 49.5), "traditional").found:
+        if plan_global(grid, (0.5, 0.5), (49.5, 49.5), "traditional", profile="paper").found:
             made += 1
             yield f"random-50x50 seed {seed - 1}", grid, (0, 0), (49, 49)
 
@@ -44,8 +44,8 @@ def test_improved_never_turns_more_and_keeps_to_free_cells(public_data):
     compared = 0
     for name, grid, start_cell, goal_cell in paper_maps(public_data):
         start, goal = grid.centre_of(start_cell), grid.centre_of(goal_cell)
-        traditional = plan_global(grid, start, goal, "traditional")
-        improved = plan_global(grid, start, goal, "improved")
+        traditional = plan_global(grid, start, goal, "traditional", profile="paper")
+        improved = plan_global(grid, start, goal, "improved", profile="paper")
         assert traditional.found and improved.found, name
         assert improved.turns <= traditional.turns, name
         assert improved.turning_angle_deg <= traditional.turning_angle_deg + 1e-9, name
@@ -92,7 +92,7 @@ def test_drop_collinear_keeps_only_turning_points():
 
 def test_plan_reports_world_coordinates_and_metrics():
     grid = parse_text_grid("....\n.##.\n....", resolution=0.5)
-    plan = plan_global(grid, (0.25, 0.25), (1.75, 1.25), "traditional")
+    plan = plan_global(grid, (0.25, 0.25), (1.75, 1.25), "traditional", profile="paper")
     assert plan.found
     assert plan.path[0] == (0.25, 0.25) and plan.path[-1] == (1.75, 1.25)
     assert plan.length == pytest.approx(path_length(plan.path))
@@ -110,12 +110,12 @@ def test_plan_reports_world_coordinates_and_metrics():
 def test_bad_points_name_the_point(start, goal, message):
     grid = parse_text_grid("....\n.##.\n....")
     with pytest.raises(MapError, match=message):
-        plan_global(grid, start, goal)
+        plan_global(grid, start, goal, profile="paper")
 
 
 def test_no_path_is_a_distinct_outcome():
     grid = parse_text_grid("..#..\n..#..")
-    plan = plan_global(grid, (0.5, 0.5), (4.5, 1.5), "improved")
+    plan = plan_global(grid, (0.5, 0.5), (4.5, 1.5), "improved", profile="paper")
     assert not plan.found
     assert plan.path == [] and plan.key_nodes == []
 
@@ -123,4 +123,4 @@ def test_no_path_is_a_distinct_outcome():
 def test_unknown_algorithm_is_rejected():
     grid = parse_text_grid("..")
     with pytest.raises(ValueError, match="unknown algorithm"):
-        plan_global(grid, (0.5, 0.5), (1.5, 0.5), "dijkstra")
+        plan_global(grid, (0.5, 0.5), (1.5, 0.5), "dijkstra", profile="paper")

@@ -16,7 +16,7 @@ from planner.dwa import DwaConfig
 from planner.fusion import FusionConfig, FusionController
 from planner.map_io import parse_text_grid
 
-FLEET = ("warehouse", "crossing", "corridor")
+FLEET = ("warehouse", "crossing", "corridor", "nav2-depot")
 PAPER_FUSION = (*(f"paper-temporary-{n}" for n in range(4)), "paper-dynamic")
 
 

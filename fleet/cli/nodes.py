@@ -19,8 +19,9 @@ from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
 from fleet.runtime.world_server import WorldServer
-from fleet.scenario import load_scenario, with_algorithm
+from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
+from planner.profiles import PROFILES
 from recordings.writer import RecordingWriter, default_recording_path
 
 
@@ -32,6 +33,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
     p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
+    p.add_argument("--profile", choices=PROFILES, help="override the scenario's planner profile")
 
 
 def add_parsers(sub) -> None:
@@ -102,6 +104,8 @@ def _scenario(args):
     scenario = load_scenario(args.scenario)
     if args.algorithm:
         scenario = with_algorithm(scenario, args.algorithm)
+    if args.profile:
+        scenario = with_profile(scenario, args.profile)
     return scenario, args.prefix or f"agv-fleet/{scenario.name}"
 
 
@@ -138,7 +142,12 @@ def run_agv(args: argparse.Namespace) -> int:
 def run_record(args: argparse.Namespace) -> int:
     scenario, prefix = _scenario(args)
     path = Path(args.output) if args.output else default_recording_path(scenario.name)
-    facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
+    facts = {
+        "mode": "zenoh",
+        "prefix": prefix,
+        "algorithm": args.algorithm or "scenario's",
+        "profile": args.profile or "scenario's",
+    }
     if args.run_id:
         facts["run_id"] = args.run_id
     with (

@@ -8,12 +8,11 @@ import json
 from fleet import exit_codes
 from fleet.builtin import bundled_maps, resolve_map
 from fleet.cli.arguments import UsageError
+from planner.clearance import DEFAULT_MARGIN, DEFAULT_RADIUS, Clearance
 from planner.errors import BadInputError
 from planner.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up
-from planner.map_io import load_map
-
-DEFAULT_RADIUS = 0.3
-DEFAULT_MARGIN = 0.2
+from planner.map_io import UNKNOWN_CHOICES, load_map
+from planner.profiles import DEFAULT, PROFILES
 
 
 def add_parser(sub) -> None:
@@ -32,15 +31,31 @@ def add_parser(sub) -> None:
     p.add_argument("--goal", nargs=2, type=float, required=True, metavar=("X", "Y"))
     p.add_argument("--algorithm", choices=(*ALGORITHMS, "both"), default="both")
     p.add_argument(
+        "--profile",
+        choices=PROFILES,
+        default=DEFAULT,
+        help=(
+            "default: plan on the costmap of the AGV's radius and margin, key nodes keep the "
+            "radius from obstacle squares; paper: the paper exactly (safety distance to "
+            "obstacle-cell centres, no inflation)"
+        ),
+    )
+    p.add_argument(
         "--radius", type=float, default=DEFAULT_RADIUS, help="AGV radius, m (default 0.3)"
     )
     p.add_argument(
         "--margin",
         type=float,
         default=DEFAULT_MARGIN,
-        help="safety margin added to the radius for key nodes, m (default 0.2)",
+        help="room kept beyond the radius where there is space, m (default 0.2)",
     )
     p.add_argument("--resolution", type=float, help="metres per cell (overrides the map's)")
+    p.add_argument(
+        "--unknown",
+        choices=UNKNOWN_CHOICES,
+        default="obstacle",
+        help="unknown cells of a ROS map: obstacles (default) or free",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
 
@@ -50,7 +65,8 @@ def run(args: argparse.Namespace) -> int:
     if args.radius < 0 or args.margin < 0:
         raise UsageError("--radius and --margin must be >= 0")
     try:
-        grid = load_map(resolve_map(args.map), resolution=args.resolution)
+        clearance = Clearance(args.radius, args.margin)
+        grid = load_map(resolve_map(args.map), resolution=args.resolution, unknown=args.unknown)
         warm_up()
         results = [
             plan_global(
@@ -58,7 +74,8 @@ def run(args: argparse.Namespace) -> int:
                 tuple(args.start),
                 tuple(args.goal),
                 algorithm,
-                safety_distance=args.radius + args.margin,
+                profile=args.profile,
+                clearance=clearance,
             )
             for algorithm in algorithms
         ]
@@ -69,7 +86,11 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(plans_json(args.map, args.start, args.goal, results)))
     else:
-        print(f"map {grid.name}: {grid.width}x{grid.height} cells at {grid.resolution:g} m")
+        x0, _, y0, _ = grid.extent
+        print(
+            f"map {grid.name}: {grid.width}x{grid.height} cells at {grid.resolution:g} m, "
+            f"origin ({x0:g}, {y0:g}); profile {args.profile}"
+        )
         print(plans_table(results))
     return exit_codes.OK if all(r.found for r in results) else exit_codes.NOT_SUCCEEDED
 
@@ -77,6 +98,7 @@ def run(args: argparse.Namespace) -> int:
 def plans_json(map_name: str, start, goal, results: list[PlanResult]) -> dict:
     return {
         "map": str(map_name),
+        "profile": results[0].profile if results else DEFAULT,
         "start": list(start),
         "goal": list(goal),
         "plans": [plan_json(r) for r in results],
@@ -90,6 +112,7 @@ def plan_json(r: PlanResult) -> dict:
         "length": round(r.length, 6) if r.found else None,
         "turns": r.turns if r.found else None,
         "turning_angle_deg": round(r.turning_angle_deg, 6) if r.found else None,
+        "clearance": round(r.clearance, 6) if r.found else None,
         "expansions": r.expansions,
         "time_ms": round(r.time_s * 1e3, 3),
         "key_nodes": [list(p) for p in r.key_nodes],
@@ -98,7 +121,10 @@ def plan_json(r: PlanResult) -> dict:
 
 
 def plans_table(results: list[PlanResult]) -> str:
-    header = ("algorithm", "length (m)", "turns", "turning angle (deg)", "expansions", "time (ms)")
+    header = (
+        "algorithm", "length (m)", "turns", "turning angle (deg)", "clearance (m)",
+        "expansions", "time (ms)",
+    )  # fmt: skip
     rows = [header]
     for r in results:
         if r.found:
@@ -108,13 +134,14 @@ def plans_table(results: list[PlanResult]) -> str:
                     f"{r.length:.2f}",
                     str(r.turns),
                     f"{r.turning_angle_deg:.1f}",
+                    f"{r.clearance:.2f}",
                     str(r.expansions),
                     f"{r.time_s * 1e3:.2f}",
                 )
             )
         else:
             rows.append(
-                (r.algorithm, "no path", "-", "-", str(r.expansions), f"{r.time_s * 1e3:.2f}")
+                (r.algorithm, "no path", "-", "-", "-", str(r.expansions), f"{r.time_s * 1e3:.2f}")
             )
     widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
     lines = [

@@ -14,8 +14,9 @@ from fleet.cli.arguments import UsageError, positive_float
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.runtime.progress import Progress
-from fleet.scenario import ScenarioError, load_scenario, with_algorithm
+from fleet.scenario import ScenarioError, load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
+from planner.profiles import PROFILES
 from recordings.rerun_view import LiveView, RerunError
 from recordings.writer import default_recording_path
 
@@ -48,6 +49,14 @@ def add_parsers(sub) -> None:
         "--algorithm",
         choices=VARIANTS,
         help="plan every AGV with this variant instead of the scenario's",
+    )
+    p.add_argument(
+        "--profile",
+        choices=PROFILES,
+        help=(
+            "plan every AGV with this planner profile instead of the scenario's: default "
+            "(costmap, footprint-safe key nodes) or paper (the paper exactly)"
+        ),
     )
     p.add_argument(
         "--realtime",
@@ -100,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario)
     if args.algorithm:
         scenario = with_algorithm(scenario, args.algorithm)
+    if args.profile:
+        scenario = with_profile(scenario, args.profile)
     if args.in_process and args.realtime:
         raise UsageError("--realtime needs the bus (drop --in-process)")
     record_path = None
@@ -129,10 +140,11 @@ def run(args: argparse.Namespace) -> int:
 
 def _run(args, scenario, record_path, progress, view):
     if args.in_process:
-        return _run_in_process(scenario, record_path, args.algorithm, progress, view)
+        return _run_in_process(scenario, record_path, args, progress, view)
     options = FleetOptions(
         scenario_arg=str(args.scenario),
         algorithm=args.algorithm,
+        profile=args.profile,
         realtime=args.realtime,
         transport=args.transport,
         zenoh_config=args.zenoh_config,
@@ -142,10 +154,14 @@ def _run(args, scenario, record_path, progress, view):
     return run_fleet(scenario, options, progress=progress, tap=view)
 
 
-def _run_in_process(scenario, record_path, algorithm, progress, view):
+def _run_in_process(scenario, record_path, args, progress, view):
     if record_path is None:
         return run_in_process(scenario, view, progress)
-    facts = {"mode": "in-process", "algorithm": algorithm or "scenario's"}
+    facts = {
+        "mode": "in-process",
+        "algorithm": args.algorithm or "scenario's",
+        "profile": args.profile or "scenario's",
+    }
     return run_recorded(scenario, record_path, facts, view, progress)
 
 

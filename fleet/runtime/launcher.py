@@ -33,6 +33,7 @@ EXIT_GRACE_S = 5.0
 class FleetOptions:
     scenario_arg: str  # what the AGV processes load: a file path or a built-in name
     algorithm: str | None = None
+    profile: str | None = None
     realtime: float | None = None
     transport: str = "unix"
     zenoh_config: str | None = None
@@ -49,6 +50,8 @@ def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: 
     cmd += ["--connect", endpoint, "--prefix", prefix]
     if options.algorithm:
         cmd += ["--algorithm", options.algorithm]
+    if options.profile:
+        cmd += ["--profile", options.profile]
     if options.zenoh_config:
         cmd += ["--zenoh-config", options.zenoh_config]
     return cmd
@@ -60,6 +63,8 @@ def recorder_command(options: FleetOptions, endpoint: str, prefix: str, run_id: 
     cmd += ["-o", str(options.record_path)]
     if options.algorithm:
         cmd += ["--algorithm", options.algorithm]
+    if options.profile:
+        cmd += ["--profile", options.profile]
     if options.zenoh_config:
         cmd += ["--zenoh-config", options.zenoh_config]
     return cmd

@@ -7,6 +7,9 @@ from dataclasses import dataclass
 
 from fleet.runtime.world import World
 from planner.agv_status import FINISHED
+from planner.fusion import GLOBAL_ALGORITHM
+from planner.global_planner import plan_global
+from planner.grid_map import MapError
 
 
 @dataclass(frozen=True)
@@ -18,6 +21,7 @@ class AgvSummary:
     collisions: int
     min_clearance: float
     failure: str = ""
+    route_length: float | None = None  # m, the AGV's first global route (None: no route)
 
 
 @dataclass(frozen=True)
@@ -49,6 +53,7 @@ class RunSummary:
                     "status": a.status,
                     "arrival_time": a.arrival_time,
                     "distance": round(a.distance, 4),
+                    "route_length": None if a.route_length is None else round(a.route_length, 4),
                     "collisions": a.collisions,
                     "min_clearance": round(a.min_clearance, 4)
                     if math.isfinite(a.min_clearance)
@@ -60,7 +65,10 @@ class RunSummary:
         }
 
     def table(self) -> str:
-        header = ("AGV", "status", "arrival (s)", "distance (m)", "collisions", "min clearance (m)")
+        header = (
+            "AGV", "status", "arrival (s)", "distance (m)", "route (m)", "collisions",
+            "min clearance (m)",
+        )  # fmt: skip
         rows = [header]
         for a in self.agvs:
             rows.append(
@@ -69,6 +77,7 @@ class RunSummary:
                     a.status,
                     "-" if a.arrival_time is None else f"{a.arrival_time:.1f}",
                     f"{a.distance:.2f}",
+                    "-" if a.route_length is None else f"{a.route_length:.2f}",
                     str(a.collisions),
                     f"{a.min_clearance:.2f}",
                 )
@@ -92,7 +101,14 @@ def summarize(world: World, wall_time: float) -> RunSummary:
             status = "timeout" if world.end_reason == "time limit" else status
         agvs.append(
             AgvSummary(
-                name, status, r.arrival_time, r.distance, r.collisions, r.min_clearance, r.failure
+                name,
+                status,
+                r.arrival_time,
+                r.distance,
+                r.collisions,
+                r.min_clearance,
+                r.failure,
+                route_length(world.scenario, name),
             )
         )
     return RunSummary(
@@ -104,3 +120,26 @@ def summarize(world: World, wall_time: float) -> RunSummary:
         end_reason=world.end_reason,
         agvs=tuple(agvs),
     )
+
+
+def route_length(scenario, name: str) -> float | None:
+    """Length (m) of the route AGV ``name`` planned first: its key nodes from its start to
+    its goal, planned again here exactly as the AGV plans it (same map, variant, profile
+    and clearance), so both run modes state it without asking the AGVs. None for DWA
+    alone (no global route) or when no path exists."""
+    spec = scenario.agv(name)
+    algorithm = GLOBAL_ALGORITHM.get(spec.config.algorithm)
+    if algorithm is None:
+        return None
+    try:
+        plan = plan_global(
+            scenario.grid,
+            spec.start,
+            spec.goal,
+            algorithm,
+            profile=spec.config.profile,
+            clearance=spec.config.clearance,
+        )
+    except MapError:
+        return None
+    return plan.length if plan.found else None

@@ -200,4 +200,11 @@ class World:
 
 def map_message(grid: GridMap) -> MapMsg:
     """The static map as published on ``world/map`` and recorded."""
-    return MapMsg(grid.name, grid.width, grid.height, grid.resolution, grid.to_text().split("\n"))
+    return MapMsg(
+        grid.name,
+        grid.width,
+        grid.height,
+        grid.resolution,
+        grid.to_text().split("\n"),
+        list(grid.origin),
+    )
