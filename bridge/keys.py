@@ -7,7 +7,16 @@ a key carries, so the recorder and the replay need no other table.
 
 from __future__ import annotations
 
-from bridge.messages import AgvState, Event, MapMsg, PlanMsg, ResultMsg, Tick, TrajectoryMsg
+from bridge.messages import (
+    AgvCommand,
+    AgvState,
+    Event,
+    MapMsg,
+    PlanMsg,
+    ResultMsg,
+    Tick,
+    TrajectoryMsg,
+)
 
 WORLD_TICK = "world/tick"
 WORLD_MAP = "world/map"
@@ -16,7 +25,12 @@ WORLD_RESULT = "world/result"
 ALIVE = "alive"
 
 
+def agv_command(name: str) -> str:
+    return f"agv/{name}/command"
+
+
 def agv_state(name: str) -> str:
+    """What AGVs answered before the world integrated commands (older recordings)."""
     return f"agv/{name}/state"
 
 
@@ -52,7 +66,8 @@ def message_type(key: str):
         return ResultMsg
     parts = key.split("/")
     if len(parts) == 3 and parts[0] == "agv":
-        return {"state": AgvState, "plan": PlanMsg, "trajectory": TrajectoryMsg}.get(parts[2])
+        kinds = {"command": AgvCommand, "state": AgvState, "plan": PlanMsg}
+        return {**kinds, "trajectory": TrajectoryMsg}.get(parts[2])
     return None
 
 

@@ -37,7 +37,8 @@ class MapMsg:
 
 @dataclass
 class AgvState:
-    """Pose (world frame) and body-frame command of one AGV at a tick."""
+    """Pose (world frame) and body-frame command of one AGV at a tick, as the world
+    integrated it (in ``Tick.agvs``)."""
 
     name: str
     tick: int
@@ -51,6 +52,28 @@ class AgvState:
     status: str = "driving"
     target: list[float] | None = None
     plan_time_ms: float = 0.0
+
+
+@dataclass
+class AgvCommand:
+    """One AGV's answer to tick k: its body-frame command for the period up to ``tick``
+    (k + 1), and what it reports. The world checks the command against the AGV's limits
+    and integrates it; an AGV never states its own pose.
+
+    ``start_heading`` is the paper's initial turn towards the first key node (the paper
+    profile turns the AGV in place before it starts): the world accepts it in the answer
+    to tick 0 only, and only for an AGV of the paper profile.
+    """
+
+    name: str
+    tick: int
+    vx: float
+    vy: float
+    omega: float
+    status: str = "driving"
+    target: list[float] | None = None
+    plan_time_ms: float = 0.0
+    start_heading: float | None = None
 
 
 @dataclass

@@ -16,3 +16,42 @@ def world_velocity(theta, vx, vy, omega, dt: float) -> np.ndarray:
     heading = np.asarray(theta) - np.asarray(omega) * dt
     c, s = np.cos(heading), np.sin(heading)
     return np.stack((vx * c - vy * s, vx * s + vy * c), axis=-1)
+
+
+Command = tuple[float, float, float]  # body frame: vx, vy (m/s), omega (rad/s)
+_TOLERANCE = 1e-9  # float slack: DWA's window edges are sums of resolution steps
+
+
+def limit_command(
+    previous, requested, limits, dt: float
+) -> tuple[tuple[float, float, float], bool]:
+    """``requested`` (vx, vy, omega) clipped to what the vehicle can do in one period
+    after ``previous``: the speed limits of ``limits`` (a ``DwaConfig``: max_speed on each
+    axis and on |(vx, vy)|, min_vx, max_omega) and its acceleration limits (max_accel per
+    linear axis, max_alpha). Returns the command and whether anything was clipped.
+
+    The world applies it to every AGV's command, so a process can only ask, never move
+    itself further than its vehicle could.
+    """
+    vx0, vy0, w0 = previous
+    dv, dw = limits.max_accel * dt, limits.max_alpha * dt
+    vmax = limits.max_speed
+    bounds = (
+        (max(vx0 - dv, limits.min_vx), min(vx0 + dv, vmax)),
+        (max(vy0 - dv, -vmax), min(vy0 + dv, vmax)),
+        (max(w0 - dw, -limits.max_omega), min(w0 + dw, limits.max_omega)),
+    )
+    out = []
+    clipped = False
+    for value, (low, high) in zip(requested, bounds, strict=True):
+        if low > high:  # over a limit already (a changed scenario): brake towards it
+            low = high = min(max(value, high), low)
+        if not low - _TOLERANCE <= value <= high + _TOLERANCE:
+            clipped = True
+            value = min(max(value, low), high)
+        out.append(float(value))
+    speed = float(np.hypot(out[0], out[1]))
+    if speed > vmax + _TOLERANCE:
+        clipped = True
+        out[0], out[1] = out[0] * vmax / speed, out[1] * vmax / speed
+    return (out[0], out[1], out[2]), clipped

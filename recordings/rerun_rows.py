@@ -131,7 +131,8 @@ class RowMaker:
         else:
             name = keys.agv_name(topic)
             handler = {
-                "state": self._state,
+                "command": self._state,
+                "state": self._state,  # recordings before the world integrated commands
                 "plan": self._plan,
                 "trajectory": self._trajectory,
             }.get(topic.rsplit("/", 1)[-1])

@@ -53,25 +53,26 @@ def hosted_world(scenario_name: str, **server_options):
 
 
 def test_zenoh_and_in_process_runs_are_identical_tick_by_tick():
-    """Every AGV's pose, command, status and local target at every tick are the same
-    floats, to the last bit, whether the AGVs are processes on the bus or not."""
+    """Every AGV's pose (as the world integrated it), command, status and local target at
+    every tick are the same floats, to the last bit, whether the AGVs are processes on the
+    bus or not."""
     expected = {}
     scenario = load_scenario("crossing")
 
     def sink(key, msg):
-        if key.endswith("/state"):
-            expected[(msg.tick, msg.name)] = state_key(msg)
+        if key == keys.WORLD_TICK:
+            expected.update({(msg.tick, s.name): state_key(s) for s in msg.agvs})
 
     reference = run_in_process(scenario, outbox=sink)
     with hosted_world("crossing") as (_, bus, server, _):
-        states = bus.subscribe("agv/*/state")
+        ticks = bus.subscribe(keys.WORLD_TICK)
         summary = server.run()
     seen = {}
-    while not states.empty():
-        msg = states.get().msg
-        seen[(msg.tick, msg.name)] = state_key(msg)
+    while not ticks.empty():
+        msg = ticks.get().msg
+        seen.update({(msg.tick, s.name): state_key(s) for s in msg.agvs})
     assert len(scenario.agvs) >= 3
-    assert len(expected) == reference.ticks * len(scenario.agvs)
+    assert len(expected) == (reference.ticks + 1) * len(scenario.agvs)  # ticks 0 to the end
     assert seen == expected
     assert summary.to_json()["agvs"] == reference.to_json()["agvs"]
 
@@ -145,10 +146,10 @@ def test_malformed_payloads_are_counted_and_ignored():
         time.sleep(1.0)
         with open_client(endpoint) as session:
             for payload in (b"not json", b'{"name": "left"}', b"[1, 2]"):
-                session.put(bus.full(keys.agv_state("left")), payload)
+                session.put(bus.full(keys.agv_command("left")), payload)
             time.sleep(0.2)
         runner.join(timeout=120)
-    assert bus.malformed[keys.agv_state("left")] == 3
+    assert bus.malformed[keys.agv_command("left")] == 3
     assert result["summary"].success
     alone = run_in_process(load_scenario("corridor")).to_json()
     assert result["summary"].to_json()["agvs"] == alone["agvs"]

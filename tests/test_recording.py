@@ -71,11 +71,11 @@ def test_every_message_of_a_run_round_trips_in_order(corridor):
         assert m.log_time_ns == m.data.get("tick", 0) * dt_ns, m.topic
 
 
-def test_each_agv_has_a_state_per_tick_and_the_map_and_plans_are_there(corridor):
+def test_each_agv_has_a_command_per_tick_and_the_map_and_plans_are_there(corridor):
     path, scenario, summary, sunk = corridor
     rec = open_recording(path)
     for agv in scenario.agvs:
-        states = rec.of(keys.agv_state(agv.name))
+        states = rec.of(keys.agv_command(agv.name))
         assert len(states) == summary.ticks
         assert [s.data["tick"] for s in states] == list(range(1, summary.ticks + 1))
         plans = [json.loads(p) for k, p in sunk if k == keys.agv_plan(agv.name)]
@@ -293,7 +293,7 @@ def test_cli_info_describes_a_recording(corridor):
     done = agv_fleet("info", str(corridor[0]))
     assert done.returncode == 0, done.stderr
     assert "corridor" in done.stdout and "success" in done.stdout
-    assert "agv/left/state" in done.stdout and "AgvState" in done.stdout
+    assert "agv/left/command" in done.stdout and "AgvCommand" in done.stdout
     described = json.loads(agv_fleet("info", str(corridor[0]), "--json").stdout)
     assert described["agvs"] == ["left", "right"] and described["finished"]
 

@@ -85,7 +85,7 @@ def test_a_recorder_killed_mid_run_leaves_a_readable_recording(tmp_path):
 
     rec = open_recording(path)
     assert rec.truncated and rec.result is None
-    states = len(rec.of("agv/west/state"))
+    states = len(rec.of("agv/west/command"))
     assert 50 < states < ticks  # what was recorded before the kill, less the open chunk
     info = subprocess.run([*CLI, "info", str(path)], capture_output=True, text=True, timeout=60)
     assert info.returncode == 0

@@ -107,7 +107,7 @@ def test_a_saved_replay_has_the_map_every_agv_its_plans_and_velocities(corridor,
         assert len(replayed[f"/world/agv/{name}/body"].rows) == len(ticks)
         plans = recording.of(f"agv/{name}/plan")
         assert len(replayed[f"/world/agv/{name}/plan"].rows) == len(plans) >= 1
-        states = recording.of(f"agv/{name}/state")
+        states = recording.of(f"agv/{name}/command")
         for q in QUANTITIES:
             series = replayed[f"/velocity/{q}/{name}"]
             assert len(series.rows) == len(states), q
@@ -116,7 +116,7 @@ def test_a_saved_replay_has_the_map_every_agv_its_plans_and_velocities(corridor,
 
 
 def test_velocity_rows_are_the_states_at_their_tick_time(corridor, replayed):
-    states = [m.data for m in corridor["recording"].of("agv/left/state")]
+    states = [m.data for m in corridor["recording"].of("agv/left/command")]
     speed = replayed["/velocity/speed/left"]
     assert [t for t, _ in speed.rows] == [round(s["tick"] * corridor["dt"] * 1e9) for s in states]
     got = [v[0] for v in speed.values("Scalars:scalars")]
@@ -200,7 +200,7 @@ def test_replay_save_writes_an_rrd_with_one_velocity_row_per_state(corridor, tmp
     assert done.returncode == 0, done.stderr
     entities = read_rrd(out)
     for name in ("left", "right"):
-        states = corridor["recording"].of(f"agv/{name}/state")
+        states = corridor["recording"].of(f"agv/{name}/command")
         assert len(entities[f"/velocity/vx/{name}"].rows) == len(states)
 
 
@@ -238,8 +238,8 @@ def test_a_truncated_recording_replays_what_was_recovered_and_says_so(corridor, 
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(data[: len(data) // 2])
     recovered = open_recording(cut)
-    states = recovered.of("agv/left/state")
-    assert 0 < len(states) < len(corridor["recording"].of("agv/left/state"))
+    states = recovered.of("agv/left/command")
+    assert 0 < len(states) < len(corridor["recording"].of("agv/left/command"))
     out = tmp_path / "cut.rrd"
     done = agv_fleet("replay", str(cut), "--save", str(out))
     assert done.returncode == 0, done.stderr

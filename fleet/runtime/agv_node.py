@@ -1,24 +1,23 @@
-"""One AGV as a state machine: a tick in, its state for the next tick out.
+"""One AGV as a state machine: a tick in, its command for the next period out.
 
-The node owns its fusion controller and integrates its own motion (Eq. 4):
-it reads its pose from the tick (the world's copy of its last answer), senses
-temporary obstacles within the sensing radius, sees every other AGV and
-moving obstacle as a disc moving at its current world-frame velocity, and
-answers with its pose and command for tick k+1. The in-process runner and the
-AGV process over Zenoh both call ``on_tick``.
+The node owns its fusion controller. It reads its pose from the tick (the
+world integrates every AGV's motion, Eq. 4), senses temporary obstacles within
+the sensing radius, sees every other AGV and moving obstacle as a disc moving
+at its current world-frame velocity, and answers with its command (vx, vy,
+omega) for tick k+1. The in-process runner and the AGV process over Zenoh both
+call ``on_tick``.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from bridge import keys
-from bridge.messages import AgvState, PlanMsg, Tick, TrajectoryMsg
+from bridge.messages import AgvCommand, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
-from planner.dwa import step_pose
+from planner.agv_status import FAILED
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
 from planner.motion import world_velocity
@@ -26,9 +25,9 @@ from planner.motion import world_velocity
 
 @dataclass
 class NodeOutput:
-    """What one AGV says after a tick: its next state, and a plan when it made one."""
+    """What one AGV says after a tick: its command, and a plan when it made one."""
 
-    state: AgvState
+    command: AgvCommand
     plan: PlanMsg | None = None
     trajectory: TrajectoryMsg | None = None
 
@@ -36,8 +35,8 @@ class NodeOutput:
 def publish_output(outbox, out: NodeOutput) -> None:
     """Send what an AGV says after a tick on its own keys: the same in both run modes
     (``outbox`` is the bus's ``publish`` or an in-process sink)."""
-    name = out.state.name
-    outbox(keys.agv_state(name), out.state)
+    name = out.command.name
+    outbox(keys.agv_command(name), out.command)
     if out.plan:
         outbox(keys.agv_plan(name), out.plan)
     if out.trajectory:
@@ -57,41 +56,43 @@ class AgvNode:
         warm_up()
         self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
 
-    def on_tick(self, tick: Tick) -> NodeOutput:
-        me = next(s for s in tick.agvs if s.name == self.name)
+    def on_tick(self, tick: Tick) -> NodeOutput | None:
+        """This AGV's answer to ``tick``; None for a tick that does not list it."""
+        me = next((s for s in tick.agvs if s.name == self.name), None)
+        if me is None:
+            return None
         pose = (me.x, me.y, me.theta)
         plan_msg = None
-        if me.status == "failed":  # the world gave up on this AGV: stand still
-            return NodeOutput(self._state(tick.tick + 1, pose, (0.0, 0.0, 0.0), "failed", None))
+        start_heading = None
+        if me.status == FAILED:  # the world gave up on this AGV: stand still
+            return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), FAILED))
         if not self._started:
             self._started = True
             pose, plan = self.controller.start(pose)
             plan_msg = self._plan_msg(tick, plan, "initial")
+            if pose[2] != me.theta:
+                start_heading = float(pose[2])
         self._sense(tick, pose)
         step = self.controller.step(pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick))
         if step.plan is not None:
             plan_msg = self._plan_msg(tick, step.plan, "replan")
-        new_pose = step_pose(pose, step.command, self.scenario.dt)
-        state = self._state(tick.tick + 1, new_pose, step.command, step.status, step.target)
-        state.plan_time_ms = step.plan_time_s * 1e3
+        command = self._command(tick, step.command, step.status, step.target)
+        command.plan_time_ms = step.plan_time_s * 1e3
+        command.start_heading = start_heading
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(
                 self.name, tick.tick, np.round(step.trajectory[:, :2], 4).tolist()
             )
-        return NodeOutput(state, plan_msg, trajectory)
+        return NodeOutput(command, plan_msg, trajectory)
 
-    def _state(self, k, pose, command, status, target) -> AgvState:
-        return AgvState(
+    def _command(self, tick: Tick, command, status: str, target=None) -> AgvCommand:
+        return AgvCommand(
             name=self.name,
-            tick=k,
-            x=float(pose[0]),
-            y=float(pose[1]),
-            theta=float(math.remainder(pose[2], 2 * math.pi)),
+            tick=tick.tick + 1,
             vx=float(command[0]),
             vy=float(command[1]),
             omega=float(command[2]),
-            radius=self.spec.radius,
             status=status,
             target=list(target) if target is not None else None,
         )

@@ -48,5 +48,7 @@ def serve_agv(scenario: Scenario, name: str, bus: Bus, start_timeout: float = 60
             continue
         if tick.final:
             continue  # the run's end state: the world's token goes next
-        publish_output(bus.publish, node.on_tick(tick))
+        out = node.on_tick(tick)
+        if out is not None:
+            publish_output(bus.publish, out)
         answered += 1

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from bridge.messages import AgvState, Tick
+from bridge.messages import AgvCommand, Tick
 from fleet.runtime.agv_node import AgvNode, publish_output
 from fleet.runtime.lockstep import Outbox, run_lockstep, tee
 from fleet.runtime.summary import RunSummary
@@ -27,12 +27,12 @@ def run_in_process(
     outbox = outbox or _discard
     nodes = {a.name: AgvNode(scenario, a.name) for a in scenario.agvs}
 
-    def collect(tick: Tick, world: World) -> dict[str, AgvState]:
+    def collect(tick: Tick, world: World) -> dict[str, AgvCommand]:
         replies = {}
         for name in world.live_agvs():
             out = nodes[name].on_tick(tick)
             publish_output(outbox, out)
-            replies[name] = out.state
+            replies[name] = out.command
         return replies
 
     return run_lockstep(World(scenario), collect, outbox, after_tick=progress)

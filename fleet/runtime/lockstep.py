@@ -18,7 +18,7 @@ from collections.abc import Callable
 from typing import Protocol
 
 from bridge import keys
-from bridge.messages import AgvState, ResultMsg, Tick
+from bridge.messages import AgvCommand, ResultMsg, Tick
 from fleet.runtime.summary import RunSummary, summarize
 from fleet.runtime.world import World, map_message
 
@@ -26,8 +26,8 @@ Outbox = Callable[[str, object], None]
 
 
 class Collector(Protocol):
-    def __call__(self, tick: Tick, world: World) -> dict[str, AgvState]:
-        """Every live AGV's answer to ``tick``, by name (missing: no answer in time)."""
+    def __call__(self, tick: Tick, world: World) -> dict[str, AgvCommand]:
+        """Every live AGV's command answering ``tick``, by name (missing: no answer)."""
 
 
 def tee(*outboxes: Outbox) -> Outbox:

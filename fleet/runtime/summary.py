@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass
 
 from fleet.runtime.world import World
-from planner.agv_status import FINISHED
+from planner.agv_status import ARRIVED, FINISHED
 from planner.fusion import GLOBAL_ALGORITHM
 from planner.global_planner import plan_global
 from planner.grid_map import MapError
@@ -22,6 +22,8 @@ class AgvSummary:
     min_clearance: float
     failure: str = ""
     route_length: float | None = None  # m, the AGV's first global route (None: no route)
+    clipped: int = 0  # commands the world clipped to the AGV's limits
+    refused: int = 0  # reports the world did not believe
 
 
 @dataclass(frozen=True)
@@ -37,7 +39,7 @@ class RunSummary:
     @property
     def success(self) -> bool:
         """Every AGV arrived and nothing collided."""
-        return self.collisions == 0 and all(a.status == "arrived" for a in self.agvs)
+        return self.collisions == 0 and all(a.status == ARRIVED for a in self.agvs)
 
     def to_json(self) -> dict:
         return {
@@ -59,6 +61,8 @@ class RunSummary:
                     if math.isfinite(a.min_clearance)
                     else None,
                     **({"failure": a.failure} if a.failure else {}),
+                    **({"clipped_commands": a.clipped} if a.clipped else {}),
+                    **({"refused_reports": a.refused} if a.refused else {}),
                 }
                 for a in self.agvs
             ],
@@ -109,6 +113,8 @@ def summarize(world: World, wall_time: float) -> RunSummary:
                 r.min_clearance,
                 r.failure,
                 route_length(world.scenario, name),
+                r.clipped,
+                r.refused,
             )
         )
     return RunSummary(

@@ -14,11 +14,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bridge.messages import AgvState, Event, MapMsg, ObstacleState, Tick
+from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.scenario import Scenario
-from planner.agv_status import FINISHED
+from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED
 from planner.distance_field import DistanceField
+from planner.dwa import step_pose
 from planner.grid_map import GridMap
+from planner.motion import limit_command
+from planner.profiles import PAPER
 
 
 @dataclass
@@ -32,11 +35,14 @@ class AgvRecord:
     collisions: int = 0
     min_clearance: float = math.inf
     failure: str = ""
+    clipped: int = 0  # commands beyond the AGV's limits, clipped by the world
+    refused: int = 0  # reports the world did not believe (an arrival away from the goal)
 
 
 class World:
     def __init__(self, scenario: Scenario):
         self.scenario = scenario
+        self.dt = scenario.dt
         self.tick = 0
         self.time = 0.0
         self.records = {a.name: AgvRecord(a.name) for a in scenario.agvs}
@@ -77,28 +83,75 @@ class World:
     def _running(self) -> list[str]:
         return [n for n, r in self.records.items() if r.status not in FINISHED]
 
-    def advance(self, replies: dict[str, AgvState]) -> Tick | None:
-        """Apply every live AGV's state for tick+1; return that tick, or None at the end."""
+    def advance(self, commands: dict[str, AgvCommand]) -> Tick | None:
+        """Integrate every live AGV's command for tick+1; return that tick, or None at the
+        end. An AGV without a command (no answer in time) stays where it was."""
         self.tick += 1
         self.time = round(self.tick * self.scenario.dt, 9)
         for name in self.live_agvs():
-            reply = replies.get(name)
-            if reply is None:
-                continue  # no answer in time: it stays where it was
-            old = self.states[name]
-            record = self.records[name]
-            record.distance += math.hypot(reply.x - old.x, reply.y - old.y)
-            reply.tick = self.tick
-            self.states[name] = reply
-            if reply.status in FINISHED and record.status not in FINISHED:
-                self._finish(name, reply.status, reply.status)
+            command = commands.get(name)
+            if command is not None:
+                self._apply(name, command)
         self._refresh_temporary()
         self._check_contacts()
         if not self._running():
-            self._end("every AGV is done")
+            self._end(self._done_reason())
         elif self.time >= self.scenario.time_limit - 1e-9:
             self._end("time limit")
         return None if self.ended else self._make_tick()
+
+    def _apply(self, name: str, command: AgvCommand) -> None:
+        """The world as physics: the command within the AGV's limits, integrated (Eq. 4).
+
+        An AGV may report ``failed`` (it gives up: stopped at once) or ``arrived`` (parked
+        at once, if it is within its goal tolerance; a claim from anywhere else is refused
+        and the AGV drives on). The paper profile's initial turn is accepted at tick 0.
+        """
+        old, record, spec = self.states[name], self.records[name], self.scenario.agv(name)
+        pose = (old.x, old.y, old.theta)
+        if command.start_heading is not None:
+            if self.tick == 1 and spec.config.profile == PAPER:
+                pose = (old.x, old.y, command.start_heading)
+            else:
+                self._refuse(name, "a start heading after tick 0 or outside the paper profile")
+        status = command.status
+        requested = (command.vx, command.vy, command.omega)
+        if status == ARRIVED and math.dist(pose[:2], spec.goal) > spec.config.goal_tolerance + 1e-9:
+            far = math.dist(pose[:2], spec.goal)
+            self._refuse(name, f"arrival claimed {far:.2f} m from the goal")
+            status = DRIVING
+        if status in FINISHED:
+            velocity = (0.0, 0.0, 0.0)  # parked, or stopped by the world
+        else:
+            previous = (old.vx, old.vy, old.omega)
+            velocity, clipped = limit_command(previous, requested, spec.config.dwa, self.dt)
+            if clipped:
+                record.clipped += 1
+                if record.clipped == 1:
+                    self.events.append(
+                        Event(self.tick, self.time, "clipped", [name], _limits_note(requested))
+                    )
+        x, y, theta = step_pose(pose, velocity, self.dt)
+        record.distance += math.hypot(x - old.x, y - old.y)
+        self.states[name] = AgvState(
+            name, self.tick, x, y, theta, *velocity, old.radius, status,
+            command.target, command.plan_time_ms,
+        )  # fmt: skip
+        if status in FINISHED and record.status not in FINISHED:
+            self._finish(name, status, status)
+
+    def _refuse(self, name: str, what: str) -> None:
+        """A report the world does not believe: counted, and an event the first time."""
+        record = self.records[name]
+        record.refused += 1
+        if record.refused == 1:
+            self.events.append(Event(self.tick, self.time, "refused", [name], what))
+
+    def _done_reason(self) -> str:
+        failed = sum(r.status == FAILED for r in self.records.values())
+        if not failed:
+            return "every AGV arrived"
+        return f"every AGV is done: {len(self.records) - failed} arrived, {failed} failed"
 
     def mark_failed(self, name: str, why: str) -> None:
         """An AGV that died or hung: it stays as a stopped obstacle at its last pose."""
@@ -106,8 +159,8 @@ class World:
             return
         state = self.states[name]
         state.vx = state.vy = state.omega = 0.0
-        state.status = "failed"
-        self._finish(name, "failed", why)
+        state.status = FAILED
+        self._finish(name, FAILED, why)
 
     def drain_events(self) -> list[Event]:
         """The events since the last call (arrivals, failures, collisions, the end)."""
@@ -207,4 +260,12 @@ def map_message(grid: GridMap) -> MapMsg:
         grid.resolution,
         grid.to_text().split("\n"),
         list(grid.origin),
+    )
+
+
+def _limits_note(requested) -> str:
+    vx, vy, omega = requested
+    return (
+        f"command vx={vx:.3f} vy={vy:.3f} m/s omega={math.degrees(omega):.1f} deg/s "
+        "is beyond the vehicle's limits: clipped (counted in the summary)"
     )

@@ -1,7 +1,7 @@
 """The world on the bus: the lockstep clock of ``World`` over Zenoh.
 
 Tick k goes out on ``world/tick``; the world then waits for every live AGV's
-state for tick k+1 on ``agv/<name>/state``. An AGV whose liveliness token
+command for tick k+1 on ``agv/<name>/command``. An AGV whose liveliness token
 disappears (its process died, or hung past its 1 s lease) or that does not
 answer within ``tick_timeout`` is marked failed and stays in the world as a
 stopped obstacle at its last pose; the others go on.
@@ -16,7 +16,7 @@ from collections.abc import Callable
 
 from bridge import keys
 from bridge.bus import Bus
-from bridge.messages import AgvState, Tick
+from bridge.messages import AgvCommand, Tick
 from fleet.runtime.lockstep import run_lockstep
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
@@ -52,7 +52,7 @@ class WorldServer:
         self.abort_check = abort_check
         self.world = World(scenario)
         self.alive: set[str] = set()
-        self._states = bus.subscribe("agv/*/state")
+        self._commands = bus.subscribe("agv/*/command")
         self._liveliness = bus.watch_alive(f"{keys.ALIVE}/agv/*")
         self._recorder = bus.watch_alive(keys.alive_recorder()) if recorder else None
 
@@ -104,9 +104,10 @@ class WorldServer:
         except queue.Empty:
             pass
 
-    def _collect(self, tick: Tick, world: World) -> dict[str, AgvState]:
-        """Every live AGV's state for the next tick, until all answered, died or timed out."""
-        replies: dict[str, AgvState] = {}
+    def _collect(self, tick: Tick, world: World) -> dict[str, AgvCommand]:
+        """Every live AGV's command for the next tick, until all answered, died or timed
+        out."""
+        replies: dict[str, AgvCommand] = {}
         wanted = tick.tick + 1
         deadline = time.monotonic() + self.tick_timeout
         while True:
@@ -120,9 +121,9 @@ class WorldServer:
                     self.world.mark_failed(name, f"no answer within {self.tick_timeout:g} s")
                 return replies
             try:
-                received = self._states.get(timeout=min(POLL_S, remaining))
+                received = self._commands.get(timeout=min(POLL_S, remaining))
             except queue.Empty:
                 continue
-            state = received.msg
-            if state.tick == wanted and received.key == keys.agv_state(state.name):
-                replies[state.name] = state
+            command = received.msg
+            if command.tick == wanted and received.key == keys.agv_command(command.name):
+                replies[command.name] = command
