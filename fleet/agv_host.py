@@ -18,9 +18,9 @@ import signal
 import sys
 
 from bridge.bus import Bus
-from bridge.session import BusError, open_client
+from bridge.session import BusError, Login, open_client
 from fleet.agv_node import AgvNode
-from fleet.agv_process import WorldGone, serve_agv
+from fleet.agv_process import NameTaken, WorldGone, serve_agv
 from fleet.scenario import Scenario
 
 _PR_SET_NAME = 15
@@ -35,11 +35,15 @@ def serve_agvs(
     *,
     connect_timeout: float = 30.0,
     zenoh_config: str | None = None,
+    logins: dict[str, Login] | None = None,
 ) -> int:
-    """Run every named AGV, each in its own process; the worst exit status."""
+    """Run every named AGV, each in its own process (logged in as ``logins[name]``
+    when given); the worst exit status."""
     AgvNode(scenario, names[0]).warm_up()
+    logins = logins or {}
+    options = (connect, prefix, connect_timeout, zenoh_config)
     if len(names) == 1:
-        return _serve_one(scenario, names[0], connect, prefix, connect_timeout, zenoh_config)
+        return _serve_one(scenario, names[0], *options, logins.get(names[0]))
     children: dict[int, str] = {}
     for name in names:
         pid = os.fork()
@@ -50,18 +54,18 @@ def serve_agvs(
                 signal.signal(signal.SIGTERM, signal.SIG_DFL)
                 _prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
                 _prctl(_PR_SET_NAME, ctypes.c_char_p(f"agv {name}"[:15].encode()))
-                code = _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config)
+                code = _serve_one(scenario, name, *options, logins.get(name))
             finally:
                 os._exit(code)
         children[pid] = name
     return _wait_for(children)
 
 
-def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config) -> int:
+def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, login) -> int:
     try:
-        with open_client(connect, connect_timeout, zenoh_config) as session:
+        with open_client(connect, connect_timeout, zenoh_config, login) as session:
             serve_agv(scenario, name, Bus(session, prefix))
-    except (BusError, WorldGone) as err:
+    except (BusError, WorldGone, NameTaken) as err:
         print(f"agv-fleet agv {name}: {err}", flush=True, file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -9,11 +9,31 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import BusError, open_client, open_router
+from bridge.session import (
+    BusError,
+    Guard,
+    Login,
+    has_authentication,
+    open_client,
+    open_router,
+)
+from bridge.trust import (
+    CREDENTIALS_ENV,
+    RECORDER_USER,
+    CredentialsError,
+    access_control,
+    agv_user,
+    exposure_warning,
+    new_credentials,
+    password_of,
+    read_credentials,
+    write_credentials,
+)
 from fleet.agv_host import serve_agvs
 from fleet.progress import Progress
 from fleet.recorder_process import serve_recorder
@@ -32,6 +52,16 @@ def _common(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
     p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
+    p.add_argument(
+        "--credentials",
+        metavar="FILE",
+        default=os.environ.get(CREDENTIALS_ENV),
+        help=(
+            "the run's Zenoh users, 'user:password' lines: the world admits only them "
+            "(and writes FILE with fresh ones if it does not exist); an AGV or the recorder "
+            f"logs in with its own (default: ${CREDENTIALS_ENV})"
+        ),
+    )
 
 
 def add_parsers(sub) -> None:
@@ -105,10 +135,33 @@ def _scenario(args):
     return scenario, args.prefix or f"agv-fleet/{scenario.name}"
 
 
+def _guard(args, scenario, prefix) -> Guard | None:
+    """The world's guard from ``--credentials``, writing fresh ones to a new file."""
+    if not args.credentials:
+        return None
+    names = [a.name for a in scenario.agvs]
+    if not os.path.exists(args.credentials):
+        write_credentials(args.credentials, new_credentials(names))
+        print(f"agv-fleet world: wrote new credentials to {args.credentials}", file=sys.stderr)
+    read_credentials(args.credentials)  # a clear error now rather than Zenoh's later
+    return Guard(args.credentials, access_control(prefix, names))
+
+
+def _login(args, user: str) -> Login | None:
+    if not args.credentials:
+        return None
+    return Login(user, password_of(read_credentials(args.credentials), user, args.credentials))
+
+
 def run_world(args: argparse.Namespace) -> int:
     try:
         scenario, prefix = _scenario(args)
-        with open_router(args.listen, args.zenoh_config) as session:
+        guard = _guard(args, scenario, prefix)
+        secured = guard is not None or has_authentication(args.zenoh_config)
+        warning = exposure_warning(args.listen, secured)
+        if warning:
+            print(f"agv-fleet world: {warning}", file=sys.stderr)
+        with open_router(args.listen, args.zenoh_config, guard) as session:
             server = WorldServer(
                 scenario,
                 Bus(session, prefix),
@@ -118,7 +171,7 @@ def run_world(args: argparse.Namespace) -> int:
                 progress=None if args.quiet else Progress(scenario),
             )
             summary = server.run()
-    except (ScenarioError, BusError) as err:
+    except (ScenarioError, BusError, CredentialsError, OSError) as err:
         print(f"agv-fleet world: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(json.dumps(summary.to_json()) if args.json else summary.table())
@@ -130,7 +183,8 @@ def run_agv(args: argparse.Namespace) -> int:
         scenario, prefix = _scenario(args)
         for name in args.name:
             scenario.agv(name)
-    except ScenarioError as err:
+        logins = {name: _login(args, agv_user(name)) for name in args.name}
+    except (ScenarioError, CredentialsError) as err:
         print(f"agv-fleet agv: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     return serve_agvs(
@@ -140,6 +194,7 @@ def run_agv(args: argparse.Namespace) -> int:
         prefix,
         connect_timeout=args.connect_timeout,
         zenoh_config=args.zenoh_config,
+        logins=logins,
     )
 
 
@@ -150,14 +205,15 @@ def run_record(args: argparse.Namespace) -> int:
         facts = {"mode": "zenoh", "prefix": prefix, "algorithm": args.algorithm or "scenario's"}
         if args.run_id:
             facts["run_id"] = args.run_id
+        login = _login(args, RECORDER_USER)
         with (
-            open_client(args.connect, args.connect_timeout, args.zenoh_config) as session,
+            open_client(args.connect, args.connect_timeout, args.zenoh_config, login) as session,
             RecordingWriter(
                 path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
             ) as writer,
         ):
             serve_recorder(Bus(session, prefix), writer, scenario.dt)
-    except (ScenarioError, BusError, OSError) as err:
+    except (ScenarioError, BusError, CredentialsError, OSError) as err:
         print(f"agv-fleet record: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
