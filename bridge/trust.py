@@ -26,6 +26,8 @@ import re
 import secrets
 from pathlib import Path
 
+from bridge.session import Guard
+
 CREDENTIALS_ENV = "AGV_FLEET_CREDENTIALS"
 RECORDER_USER = "recorder"
 # what every participant may receive and watch; a client must see the declarations of
@@ -57,6 +59,21 @@ def write_credentials(path: Path, credentials: dict[str, str]) -> None:
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
     with os.fdopen(fd, "w") as f:
         f.writelines(f"{user}:{password}\n" for user, password in credentials.items())
+
+
+def write_run_credentials(folder: str, agv_names: list[str], prefix: str) -> tuple[Guard, dict]:
+    """Fresh credentials for a run in a private ``folder``: the router's guard (a
+    dictionary of every user) and, for the ``"agvs"`` and the ``"recorder"``
+    processes, a file holding only their own users."""
+    credentials = new_credentials(agv_names)
+    dictionary = os.path.join(folder, "users")
+    write_credentials(dictionary, credentials)
+    roles = {"agvs": [agv_user(n) for n in agv_names], "recorder": [RECORDER_USER]}
+    files = {}
+    for role, users in roles.items():
+        files[role] = os.path.join(folder, role)
+        write_credentials(files[role], {u: credentials[u] for u in users})
+    return Guard(dictionary, access_control(prefix, agv_names)), files
 
 
 def read_credentials(path: str | Path) -> dict[str, str]:

@@ -25,15 +25,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import Guard, fresh_endpoint, new_run_id, open_router, run_prefix
-from bridge.trust import (
-    CREDENTIALS_ENV,
-    RECORDER_USER,
-    access_control,
-    agv_user,
-    new_credentials,
-    write_credentials,
-)
+from bridge.session import fresh_endpoint, new_run_id, open_router, run_prefix
+from bridge.trust import CREDENTIALS_ENV, write_run_credentials
 from fleet.scenario import Scenario
 from fleet.summary import RunSummary
 from fleet.world import World
@@ -95,7 +88,7 @@ def run_fleet(
     with _children_ended(children), _sigterm_as_interrupt():
         try:
             names = [agv.name for agv in scenario.agvs]
-            guard, child_files = _make_credentials(run_dir, names, prefix)
+            guard, child_files = write_run_credentials(run_dir, names, prefix)
             children.append(
                 _spawn(agv_command(options, names, endpoint, prefix), child_files["agvs"])
             )
@@ -125,18 +118,6 @@ def run_fleet(
                 return summary
         finally:
             shutil.rmtree(run_dir, ignore_errors=True)
-
-
-def _make_credentials(run_dir: str, names: list[str], prefix: str) -> tuple[Guard, dict]:
-    """The router's guard (every user) and, per child, a file with only its users."""
-    credentials = new_credentials(names)
-    dictionary = os.path.join(run_dir, "users")
-    write_credentials(dictionary, credentials)
-    child_files = {}
-    for child, users in (("agvs", [agv_user(n) for n in names]), ("recorder", [RECORDER_USER])):
-        child_files[child] = os.path.join(run_dir, child)
-        write_credentials(child_files[child], {u: credentials[u] for u in users})
-    return Guard(dictionary, access_control(prefix, names)), child_files
 
 
 def _tapped(bus: Bus, tap, progress):

@@ -1,4 +1,9 @@
-"""Finding the fleet's processes by PID through /proc (Linux), for the tests."""
+"""Finding the fleet's processes by PID through /proc (Linux), for the tests.
+
+Only processes of this test session count: they inherit ``TEST_SESSION_ENV``
+from it (even once reparented), so a test never sees, or kills, the processes
+of another test session or run on the same machine.
+"""
 
 from __future__ import annotations
 
@@ -6,7 +11,12 @@ import contextlib
 import os
 import signal
 import time
+import uuid
 from pathlib import Path
+
+TEST_SESSION_ENV = "AGV_FLEET_TEST_SESSION"
+os.environ.setdefault(TEST_SESSION_ENV, uuid.uuid4().hex)
+_MARK = f"{TEST_SESSION_ENV}={os.environ[TEST_SESSION_ENV]}".encode()
 
 
 def _read(path: Path) -> str:
@@ -25,9 +35,16 @@ def fleet_processes() -> dict[int, str]:
             continue
         cmdline = _read(entry / "cmdline").replace("\0", " ")
         stat = _read(entry / "stat")
-        if "fleet.cli" in cmdline and ") Z " not in stat:  # zombies are already dead
-            found[int(entry.name)] = _read(entry / "comm").strip()
+        if "fleet.cli" in cmdline and ") Z " not in stat and _ours(entry):
+            found[int(entry.name)] = _read(entry / "comm").strip()  # zombies are already dead
     return found
+
+
+def _ours(entry: Path) -> bool:
+    try:
+        return _MARK in (entry / "environ").read_bytes().split(b"\0")
+    except OSError:
+        return False
 
 
 def agv_pid(name: str, timeout: float = 30.0) -> int:
