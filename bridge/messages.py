@@ -281,7 +281,7 @@ def _schema_of(hint) -> dict:
         properties = {f.name: _schema_of(hints[f.name]) for f in fields}
         for (cls, name), choices in CHOICES.items():
             if cls is hint:
-                properties[name] = {"enum": list(choices)}
+                properties[name] = {"type": "string", "enum": list(choices)}
         return {
             "type": "object",
             "properties": properties,

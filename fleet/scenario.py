@@ -28,6 +28,7 @@ from fleet.toml_schema import (
 from planner.dwa import DwaConfig
 from planner.fusion import VARIANTS, FusionConfig
 from planner.grid_map import GridMap, MapError
+from planner.limits import read_input_file
 from planner.map_io import load_map, parse_text_grid
 from planner.random_map import random_map
 
@@ -35,6 +36,10 @@ TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius",
     "map", "planner", "agv_defaults", "agvs", "obstacles",
 )  # fmt: skip
+# the control period (s) and the longest run (s): at most 3.6 million ticks, and no
+# run whose clock never reaches its end (a dt of 1e-9 was accepted)
+DT_RANGE = (0.01, 1.0)
+MAX_TIME_LIMIT = 36_000.0
 MAP_KEYS = ("resolution", "grid", "file", "random")
 RANDOM_KEYS = ("width", "height", "obstacle_ratio", "seed")
 # [planner]: TOML key -> (FusionConfig or DwaConfig field, scale to internal units)
@@ -126,7 +131,9 @@ def resolve_scenario(name_or_path: str) -> Path:
 def load_scenario(name_or_path: str | Path) -> Scenario:
     path = resolve_scenario(str(name_or_path))
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_input_file(path, "scenario").decode("utf-8")
+    except MapError as err:
+        raise ScenarioError(str(err)) from None
     except (OSError, UnicodeDecodeError) as err:
         raise ScenarioError(f"cannot read scenario {path}: {err}") from None
     return parse_scenario(text, path)
@@ -140,7 +147,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         raise ScenarioError(f"{where}: not valid TOML: {err}") from None
     check_keys(doc, TOP_KEYS, "")
     name = get_str(doc, "name", "", default=path.stem if path else "scenario")
-    dt = get_number(doc, "dt", "", default=0.1, positive=True)
+    dt = get_number(doc, "dt", "", default=0.1, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
     grid = _parse_map(get_table(doc, "map", "", required=True), path, name, doc)
     planner_defaults = get_table(doc, "planner", "")
     vehicle_defaults = get_table(doc, "agv_defaults", "")
@@ -152,7 +159,9 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         name=name,
         description=get_str(doc, "description", "", default=""),
         dt=dt,
-        time_limit=get_number(doc, "time_limit", "", default=300.0, positive=True),
+        time_limit=get_number(
+            doc, "time_limit", "", default=300.0, positive=True, maximum=MAX_TIME_LIMIT
+        ),
         sensing_radius=get_number(doc, "sensing_radius", "", default=5.0, minimum=0.0),
         grid=grid,
         agvs=agvs,
