@@ -2,8 +2,8 @@
 
 It subscribes to everything under the run prefix before tick 0 (the world
 waits for its liveliness token), stores valid payloads without re-encoding
-them at their simulated time (invalid ones are counted by the bus, and the
-count goes into the ``result`` metadata as ``invalid_messages``), and ends
+them at their simulated time (invalid ones are counted by the bus; the
+counts, if any, go into the ``result`` metadata as ``invalid_messages``), and ends
 when the world's token goes: it then writes the run's result (from
 ``world/result``) and the footer. If it is killed, the
 completed chunks stay readable (see recordings.writer).
@@ -59,7 +59,9 @@ def serve_recorder(bus: Bus, writer: RecordingWriter, dt: float) -> int:
         if received.key == keys.WORLD_RESULT:
             result = _result(received.msg.summary)
     if result is not None:
-        writer.finish({**result, "invalid_messages": dict(bus.invalid)})
+        if bus.invalid:  # else the same result as a run in process
+            result["invalid_messages"] = dict(bus.invalid)
+        writer.finish(result)
     else:
         writer.close()
     return count

@@ -202,9 +202,11 @@ def _parse_map(table: dict, path: Path | None, name: str, doc: dict) -> GridMap:
             if isinstance(agv, dict) and key in agv:
                 x, y = as_point(agv[key], f"agvs[{i}].{key}")
                 keep.append((math.floor(x / res), math.floor(y / res)))
-    return random_map(
-        width, height, ratio, get_int(spec, "seed", "map.random", default=0), keep, res
-    )
+    seed = get_int(spec, "seed", "map.random", default=0)
+    try:
+        return random_map(width, height, ratio, seed, keep, res)
+    except MapError as err:
+        raise ScenarioError(f"map: {err}") from None
 
 
 def _parse_config(

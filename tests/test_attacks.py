@@ -45,6 +45,8 @@ from bridge.trust import (
 from fleet.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from fleet.world_process import WorldServer
+from recordings.reader import open_recording
+from recordings.writer import RecordingWriter
 from tests.processes import agv_pid, fleet_processes
 
 CLI = [sys.executable, "-m", "fleet.cli"]
@@ -309,3 +311,49 @@ def test_credentials_stay_off_command_lines_private_and_are_removed_after_the_ru
     out, _ = proc.communicate(timeout=120)
     assert proc.returncode == 0, out
     assert not os.path.exists(os.path.dirname(path))
+
+
+# --- a poisoned recording ------------------------------------------------------------
+
+POISON = [
+    (keys.WORLD_TICK, FOREIGN),  # foreign JSON: 'replay' died on KeyError: 'tick'
+    (keys.WORLD_EVENT, NESTED),  # 'analyze' and 'replay' traced back
+    (keys.agv_state("left"), json.dumps({**_state_dict(5), "x": float("nan")}).encode()),
+    (keys.agv_plan("left"), b'{"name": "left", "path": "everywhere"}'),
+    (keys.WORLD_MAP, b"\xff\xfe"),
+]
+
+
+def test_a_poisoned_recording_reads_as_the_clean_one(tmp_path):
+    clean, poisoned = tmp_path / "clean.mcap", tmp_path / "poisoned.mcap"
+    made = subprocess.run(
+        [*CLI, "run", SCENARIO, "--in-process", "-q", "-o", str(clean)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    rec = open_recording(clean)
+    with RecordingWriter(
+        poisoned, scenario_name=SCENARIO, scenario_text=rec.scenario_text, run_facts=rec.run
+    ) as writer:
+        for i, m in enumerate(rec.records):
+            writer.write_payload(m.topic, m.payload, m.log_time_ns)
+            if i % 100 == 1:
+                for key, payload in POISON:
+                    writer.write_payload(key, payload, m.log_time_ns)
+        writer.finish(rec.result)
+
+    def cli(*args):
+        proc = subprocess.run([*CLI, *args], capture_output=True, text=True, timeout=120)
+        assert proc.returncode == 0 and "Traceback" not in proc.stderr, proc.stderr
+        return proc.stdout
+
+    (from_poisoned,) = json.loads(cli("analyze", str(poisoned), "--json"))["recordings"]
+    (from_clean,) = json.loads(cli("analyze", str(clean), "--json"))["recordings"]
+    assert from_poisoned.pop("path") != from_clean.pop("path")
+    assert from_poisoned == from_clean
+    cli("info", str(poisoned))
+    cli("replay", str(poisoned), "--save", str(tmp_path / "poisoned.rrd"))
+    assert open_recording(poisoned).undecodable == 0  # nothing decoded until asked
+    poisoned_rec = open_recording(poisoned)
+    assert len(poisoned_rec.messages) == len(rec.records)
+    assert poisoned_rec.undecodable == len(poisoned_rec.records) - len(rec.records)
