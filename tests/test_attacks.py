@@ -69,6 +69,7 @@ class Run:
     credentials: dict[str, str]  # the AGV processes' users (empty for an open run)
     agv_env: dict[str, str]
     host: subprocess.Popen
+    attacking: threading.Event
     attacked: threading.Event
 
     def login(self, user: str) -> Login:
@@ -81,7 +82,8 @@ class Run:
 @contextmanager
 def fleet_on_bus(guarded: bool, start_agvs: bool = True, **server_options):
     """The world in this process (its router guarded or open), the AGVs in a real
-    process; ``attacked`` is set once the world passed ATTACK_AT_TICK."""
+    process. At ATTACK_AT_TICK the world sets ``attacking`` and waits (with the AGVs
+    waiting for its next tick) until ``attacked`` is set: every attack lands mid-run."""
     scenario = load_scenario(SCENARIO)
     names = [a.name for a in scenario.agvs]
     folder = tempfile.mkdtemp(prefix="agv-fleet-test-")
@@ -99,17 +101,20 @@ def fleet_on_bus(guarded: bool, start_agvs: bool = True, **server_options):
         text=True,
         start_new_session=True,
     )
-    attacked = threading.Event()
+    attacking, attacked = threading.Event(), threading.Event()
 
     def progress(world):
-        if world.tick >= ATTACK_AT_TICK:
-            attacked.set()
+        if world.tick == ATTACK_AT_TICK:
+            attacking.set()
+            attacked.wait(timeout=60)
 
     try:
         with open_router(endpoint, guard=guard) as session:
             bus = Bus(session, prefix)
             server = WorldServer(scenario, bus, progress=progress, **server_options)
-            yield Run(bus, server, endpoint, prefix, credentials, agv_env, host, attacked)
+            yield Run(
+                bus, server, endpoint, prefix, credentials, agv_env, host, attacking, attacked
+            )
     finally:
         try:
             host.wait(timeout=15)
@@ -120,20 +125,23 @@ def fleet_on_bus(guarded: bool, start_agvs: bool = True, **server_options):
 
 
 def run_under_attack(run: Run, attack) -> dict:
-    """Run the world; ``attack(run)`` runs in a thread once the run is under way."""
+    """Run the world; ``attack(run)`` runs in a thread while the world waits at
+    ATTACK_AT_TICK."""
     failures = []
 
     def attacker():
-        if run.attacked.wait(timeout=60):
+        if run.attacking.wait(timeout=60):
             try:
                 attack(run)
             except Exception as err:  # reported by the test below
                 failures.append(err)
+            finally:
+                run.attacked.set()
 
     thread = threading.Thread(target=attacker)
     thread.start()
     summary = run.server.run()
-    run.attacked.set()
+    run.attacking.set()  # a run that ended before the attack: the thread ends too
     thread.join(timeout=60)
     assert not failures, failures
     return summary.to_json()
@@ -157,7 +165,7 @@ def test_a_local_client_without_the_runs_credentials_cannot_join(undisturbed):
                 open_client(run.endpoint, timeout=0.5, login=login)
             refused.append(str(err.value))
 
-    with fleet_on_bus(guarded=True, realtime=20.0) as run:
+    with fleet_on_bus(guarded=True) as run:
         summary = run_under_attack(run, attack)
     assert len(refused) == 2
     assert summary["agvs"] == undisturbed
@@ -181,7 +189,7 @@ def test_another_agvs_credentials_cannot_forge_agv1s_state_tick_or_token(undistu
                 run.put(s, keys.WORLD_TICK, encode(Tick(k, k * 0.1, [])))
                 time.sleep(0.005)
 
-    with fleet_on_bus(guarded=True, realtime=20.0) as run:
+    with fleet_on_bus(guarded=True) as run:
         summary = run_under_attack(run, attack)
     assert summary["agvs"] == undisturbed
     assert not seen
@@ -217,7 +225,7 @@ def test_a_second_process_with_a_running_agvs_name_is_refused(undisturbed):
             env=run.agv_env, capture_output=True, text=True, timeout=60,
         )  # fmt: skip
 
-    with fleet_on_bus(guarded=True, realtime=10.0) as run:
+    with fleet_on_bus(guarded=True) as run:
         summary = run_under_attack(run, attack)
     proc = second["proc"]
     assert proc.returncode == 2
@@ -274,7 +282,7 @@ def test_an_open_run_shrugs_off(attack_name, undisturbed):
                 run.put(s, key, payload)
             time.sleep(0.3)  # let the last ones arrive before the session closes
 
-    with fleet_on_bus(guarded=False, realtime=20.0) as run:
+    with fleet_on_bus(guarded=False) as run:
         summary = run_under_attack(run, attack)
     _, agv_errors = run.host.communicate(timeout=30)
     assert run.host.returncode == 0, agv_errors
@@ -294,7 +302,7 @@ def test_an_open_run_shrugs_off(attack_name, undisturbed):
 
 def test_credentials_stay_off_command_lines_private_and_are_removed_after_the_run():
     proc = subprocess.Popen(
-        [*CLI, "run", SCENARIO, "-q", "--json", "--realtime", "10", "--no-record"],
+        [*CLI, "run", SCENARIO, "-q", "--json", "--realtime", "20", "--no-record"],
         stdout=subprocess.PIPE,
         text=True,
     )
