@@ -8,10 +8,8 @@ so the in-process mode uses the same types.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import functools
-import math
 import types
 import typing
 from dataclasses import dataclass, field
@@ -230,13 +228,17 @@ def _converter(hint):
     raise TypeError(f"unsupported field type {hint!r}")
 
 
+_FLOAT_INT = 2**1023  # ints beyond any float's range do not convert
+
+
 def _to_float(v, where):
     """A finite number: JSON from Python may carry NaN and Infinity, and one NaN pose
     would run through the planner and every later tick."""
-    if type(v) is float or type(v) is int:
-        with contextlib.suppress(OverflowError):  # an int beyond any float
-            if math.isfinite(v := float(v)):
-                return v
+    if type(v) is float:
+        if v - v == 0.0:  # not for NaN or an infinity (a call to math.isfinite costs more)
+            return v
+    elif type(v) is int and -_FLOAT_INT < v < _FLOAT_INT:
+        return float(v)
     raise MessageError(f"{where}: expected a finite number, got {v!r}"[:200])
 
 
