@@ -32,7 +32,7 @@ CREDENTIALS_ENV = "AGV_FLEET_CREDENTIALS"
 RECORDER_USER = "recorder"
 # what every participant may receive and watch; a client must see the declarations of
 # subscribers, or its publishers stop sending once they learn there is no one to send to
-_RECEIVE = ["put", "liveliness_token", "reply", "declare_subscriber"]
+_RECEIVE = ["put", "liveliness_token", "declare_subscriber"]
 _WATCH = ["declare_liveliness_subscriber", "liveliness_query"]
 
 
