@@ -141,7 +141,10 @@ def _guard(args, scenario, prefix) -> Guard | None:
         return None
     names = [a.name for a in scenario.agvs]
     if not os.path.exists(args.credentials):
-        write_credentials(args.credentials, new_credentials(names))
+        try:
+            write_credentials(args.credentials, new_credentials(names))
+        except OSError as err:
+            raise CredentialsError(f"cannot write {args.credentials}: {err.strerror}") from None
         print(f"agv-fleet world: wrote new credentials to {args.credentials}", file=sys.stderr)
     read_credentials(args.credentials)  # a clear error now rather than Zenoh's later
     return Guard(args.credentials, access_control(prefix, names))
@@ -171,7 +174,7 @@ def run_world(args: argparse.Namespace) -> int:
                 progress=None if args.quiet else Progress(scenario),
             )
             summary = server.run()
-    except (ScenarioError, BusError, CredentialsError, OSError) as err:
+    except (ScenarioError, BusError, CredentialsError) as err:
         print(f"agv-fleet world: {err}", file=sys.stderr)
         return EXIT_BAD_INPUT
     print(json.dumps(summary.to_json()) if args.json else summary.table())
