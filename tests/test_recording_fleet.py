@@ -81,8 +81,8 @@ def test_a_recorder_killed_mid_run_leaves_a_readable_recording(tmp_path):
     recorder = _recorder_pid()
     time.sleep(4.0)  # ~20 s of the 44 s simulated
     os.kill(recorder, signal.SIGKILL)
-    out, _ = run.communicate(timeout=300)
-    assert run.returncode == 0  # the run itself goes on without its recorder
+    out, err = run.communicate(timeout=300)
+    assert run.returncode == 0, err  # the run itself goes on without its recorder
     ticks = json.loads(out)["ticks"]
 
     rec = open_recording(path)

@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from bridge.session import fresh_endpoint
+from bridge.session import fresh_endpoint, has_authentication
 from bridge.trust import (
     CredentialsError,
     agv_user,
@@ -66,3 +66,12 @@ def test_credentials_files_are_private_and_hold_a_user_per_agv_and_the_recorder(
     (tmp_path / "bad").write_text("no separator here\n")
     with pytest.raises(CredentialsError, match="not a 'user:password' line"):
         read_credentials(tmp_path / "bad")
+
+
+def test_a_zenoh_config_with_tls_or_a_user_dictionary_counts_as_secured(tmp_path):
+    tls, users, plain = tmp_path / "tls.json5", tmp_path / "users.json5", tmp_path / "plain.json5"
+    tls.write_text('{transport: {link: {tls: {listen_certificate: "w.pem"}}}}')
+    users.write_text('{transport: {auth: {usrpwd: {dictionary_file: "users"}}}}')
+    plain.write_text("{transport: {link: {tx: {lease: 5000}}}}")
+    assert has_authentication(str(tls)) and has_authentication(str(users))
+    assert not has_authentication(str(plain)) and not has_authentication(None)
