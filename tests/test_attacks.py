@@ -300,6 +300,22 @@ def test_an_open_run_shrugs_off(attack_name, undisturbed):
         assert len(agv_errors.splitlines()) == 2  # once in each AGV's process
 
 
+def test_an_open_run_ignores_the_liveliness_token_of_an_agv_it_does_not_have(undisturbed):
+    """A token of an unknown AGV that comes and goes (its loss was a KeyError in the world)."""
+
+    def attack(run: Run):
+        with open_client(run.endpoint, timeout=5) as s:
+            token = s.liveliness().declare_token(run.bus.full(keys.alive_agv("ghost")))
+            time.sleep(0.2)
+            token.undeclare()
+            time.sleep(0.2)
+
+    with fleet_on_bus(guarded=False) as run:
+        summary = run_under_attack(run, attack)
+    assert summary["agvs"] == undisturbed
+    assert run.bus.invalid[keys.alive_agv("ghost")] == 2  # its coming and its going
+
+
 def test_credentials_stay_off_command_lines_private_and_are_removed_after_the_run():
     proc = subprocess.Popen(
         [*CLI, "run", SCENARIO, "-q", "--json", "--realtime", "20", "--no-record"],
