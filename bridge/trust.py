@@ -27,6 +27,8 @@ import secrets
 from pathlib import Path
 
 from bridge.session import Guard
+from planner.grid_map import MapError
+from planner.limits import read_input_file
 
 CREDENTIALS_ENV = "AGV_FLEET_CREDENTIALS"
 RECORDER_USER = "recorder"
@@ -78,9 +80,11 @@ def write_run_credentials(folder: str, agv_names: list[str], prefix: str) -> tup
 
 def read_credentials(path: str | Path) -> dict[str, str]:
     try:
-        text = Path(path).read_text()
+        text = read_input_file(Path(path), "credentials").decode()
     except (OSError, UnicodeDecodeError) as err:
         raise CredentialsError(f"cannot read credentials {path}: {err}") from None
+    except MapError as err:  # not a regular file, too large
+        raise CredentialsError(str(err)) from None
     found = {}
     for line in text.splitlines():
         user, sep, password = line.partition(":")

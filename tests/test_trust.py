@@ -63,6 +63,9 @@ def test_credentials_files_are_private_and_hold_a_user_per_agv_and_the_recorder(
     assert len(set(credentials.values())) == 3  # every password its own
     with pytest.raises(FileExistsError):
         write_credentials(path, credentials)  # never overwrites (or follows a planted link)
+    os.mkfifo(tmp_path / "fifo")
+    with pytest.raises(CredentialsError, match="is not a regular file"):
+        read_credentials(tmp_path / "fifo")
     (tmp_path / "bad").write_text("no separator here\n")
     with pytest.raises(CredentialsError, match="not a 'user:password' line"):
         read_credentials(tmp_path / "bad")
