@@ -184,8 +184,10 @@ def run_world(args: argparse.Namespace) -> int:
 def run_agv(args: argparse.Namespace) -> int:
     try:
         scenario, prefix = _scenario(args)
-        for name in args.name:
+        for i, name in enumerate(args.name):
             scenario.agv(name)
+            if name in args.name[:i]:
+                raise ScenarioError(f"--name {name} is given twice")
         logins = {name: _login(args, agv_user(name)) for name in args.name}
     except (ScenarioError, CredentialsError) as err:
         print(f"agv-fleet agv: {err}", file=sys.stderr)

@@ -78,3 +78,13 @@ def test_a_zenoh_config_with_tls_or_a_user_dictionary_counts_as_secured(tmp_path
     plain.write_text("{transport: {link: {tx: {lease: 5000}}}}")
     assert has_authentication(str(tls)) and has_authentication(str(users))
     assert not has_authentication(str(plain)) and not has_authentication(None)
+
+
+def test_one_agv_command_refuses_the_same_name_twice():
+    proc = subprocess.run(
+        [*CLI, "agv", "corridor", "--name", "left", "--name", "left", "--connect",
+         fresh_endpoint()],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert proc.returncode == 2
+    assert proc.stderr == "agv-fleet agv: --name left is given twice\n"
