@@ -26,7 +26,7 @@ import re
 import secrets
 from pathlib import Path
 
-from bridge.session import Guard
+from bridge.session import Guard, Login
 from planner.grid_map import MapError
 from planner.limits import read_input_file
 
@@ -95,11 +95,25 @@ def read_credentials(path: str | Path) -> dict[str, str]:
     return found
 
 
-def password_of(credentials: dict[str, str], user: str, path) -> str:
-    try:
-        return credentials[user]
-    except KeyError:
-        raise CredentialsError(f"{path} holds no credentials for user {user!r}") from None
+def login_from(path: str | Path, user: str) -> Login:
+    """``user``'s login from a credentials file."""
+    credentials = read_credentials(path)
+    if user not in credentials:
+        raise CredentialsError(f"{path} holds no credentials for user {user!r}")
+    return Login(user, credentials[user])
+
+
+def guard_from(path: str | Path, agv_names: list[str], prefix: str) -> tuple[Guard, bool]:
+    """A world's guard from a credentials file, which is written with fresh
+    credentials if it does not exist (True then)."""
+    created = not os.path.exists(path)
+    if created:
+        try:
+            write_credentials(path, new_credentials(agv_names))
+        except OSError as err:
+            raise CredentialsError(f"cannot write {path}: {err.strerror}") from None
+    read_credentials(path)  # a clear error now rather than Zenoh's later
+    return Guard(str(path), access_control(prefix, agv_names)), created
 
 
 def access_control(prefix: str, agv_names: list[str]) -> dict:

@@ -26,13 +26,10 @@ from bridge.trust import (
     CREDENTIALS_ENV,
     RECORDER_USER,
     CredentialsError,
-    access_control,
     agv_user,
     exposure_warning,
-    new_credentials,
-    password_of,
-    read_credentials,
-    write_credentials,
+    guard_from,
+    login_from,
 )
 from fleet.agv_host import serve_agvs
 from fleet.progress import Progress
@@ -136,24 +133,16 @@ def _scenario(args):
 
 
 def _guard(args, scenario, prefix) -> Guard | None:
-    """The world's guard from ``--credentials``, writing fresh ones to a new file."""
     if not args.credentials:
         return None
-    names = [a.name for a in scenario.agvs]
-    if not os.path.exists(args.credentials):
-        try:
-            write_credentials(args.credentials, new_credentials(names))
-        except OSError as err:
-            raise CredentialsError(f"cannot write {args.credentials}: {err.strerror}") from None
+    guard, created = guard_from(args.credentials, [a.name for a in scenario.agvs], prefix)
+    if created:
         print(f"agv-fleet world: wrote new credentials to {args.credentials}", file=sys.stderr)
-    read_credentials(args.credentials)  # a clear error now rather than Zenoh's later
-    return Guard(args.credentials, access_control(prefix, names))
+    return guard
 
 
 def _login(args, user: str) -> Login | None:
-    if not args.credentials:
-        return None
-    return Login(user, password_of(read_credentials(args.credentials), user, args.credentials))
+    return login_from(args.credentials, user) if args.credentials else None
 
 
 def run_world(args: argparse.Namespace) -> int:
