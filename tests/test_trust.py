@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import json
 import os
+import shutil
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -17,6 +20,8 @@ from bridge.trust import (
     read_credentials,
     write_credentials,
 )
+from fleet.inprocess import run_in_process
+from fleet.scenario import load_scenario
 
 CLI = [sys.executable, "-m", "fleet.cli"]
 
@@ -88,3 +93,60 @@ def test_one_agv_command_refuses_the_same_name_twice():
     )  # fmt: skip
     assert proc.returncode == 2
     assert proc.stderr == "agv-fleet agv: --name left is given twice\n"
+
+
+def _certificates(folder) -> None:
+    """A CA and a certificate for localhost signed by it (ca.pem, world.key, world.pem)."""
+
+    def openssl(*args):
+        subprocess.run(["openssl", *args], cwd=folder, check=True, capture_output=True)
+
+    openssl("req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", "ca.key", "-out",
+            "ca.pem", "-days", "2", "-subj", "/CN=agv-fleet test CA")  # fmt: skip
+    openssl("req", "-newkey", "rsa:2048", "-nodes", "-keyout", "world.key", "-out",
+            "world.csr", "-subj", "/CN=localhost")  # fmt: skip
+    (folder / "san.cnf").write_text("subjectAltName=DNS:localhost\n")
+    openssl("x509", "-req", "-in", "world.csr", "-CA", "ca.pem", "-CAkey", "ca.key",
+            "-CAcreateserial", "-out", "world.pem", "-extfile", "san.cnf")  # fmt: skip
+
+
+@pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl command")
+def test_the_readmes_secure_set_up_runs_and_refuses_an_agv_without_the_ca(tmp_path):
+    _certificates(tmp_path)
+    world_config, agv_config = tmp_path / "world.json5", tmp_path / "agv.json5"
+    tls = f'listen_private_key: "{tmp_path}/world.key", listen_certificate: "{tmp_path}/world.pem"'
+    world_config.write_text(f"{{transport: {{link: {{tls: {{{tls}}}}}}}}}")
+    tls = f'root_ca_certificate: "{tmp_path}/ca.pem"'
+    agv_config.write_text(f"{{transport: {{link: {{tls: {{{tls}}}}}}}}}")
+    endpoint = "tls/localhost:" + fresh_endpoint("tcp").rsplit(":", 1)[1]
+    users = tmp_path / "run.users"
+    common = ["corridor", "--prefix", "site/run-1", "--credentials", str(users)]
+    world = subprocess.Popen(
+        [*CLI, "world", *common, "--listen", endpoint, "--zenoh-config", str(world_config),
+         "--json", "-q"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        while not users.exists():  # the world writes the credentials first
+            assert world.poll() is None, world.communicate()
+            time.sleep(0.05)
+        no_ca = subprocess.run(
+            [*CLI, "agv", *common, "--name", "left", "--connect", endpoint,
+             "--connect-timeout", "1"],
+            capture_output=True, text=True, timeout=60,
+        )  # fmt: skip
+        agvs = subprocess.run(
+            [*CLI, "agv", *common, "--name", "left", "--name", "right", "--connect", endpoint,
+             "--zenoh-config", str(agv_config)],
+            capture_output=True, text=True, timeout=120,
+        )  # fmt: skip
+        out, err = world.communicate(timeout=120)
+    finally:
+        if world.poll() is None:
+            world.kill()
+    assert no_ca.returncode == 2 and "refused these credentials" in no_ca.stderr
+    assert agvs.returncode == 0, agvs.stderr
+    assert world.returncode == 0, err
+    assert "warning" not in err
+    alone = run_in_process(load_scenario("corridor")).to_json()
+    assert json.loads(out)["agvs"] == alone["agvs"]
