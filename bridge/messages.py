@@ -18,6 +18,9 @@ AGV_STATUSES = ("driving", "arrived", "blocked", "failed")
 # No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
 # a decoded message is bounded however it was made.
 MAX_LIST_ITEMS = 1_000_000
+# No count in a message is larger (a run has at most a few million ticks, a map a few
+# million cells); a tick times the longest dt in nanoseconds still fits an MCAP log time.
+MAX_COUNT = 2**31 - 1
 
 
 @dataclass
@@ -243,10 +246,10 @@ def _to_float(v, where):
 
 
 def _natural(v, where):
-    """Every integer of a message counts something (ticks, cells, turns): 0 <= v < 2**53."""
-    if type(v) is int and 0 <= v < 2**53:
+    """Every integer of a message counts something (ticks, cells, turns)."""
+    if type(v) is int and 0 <= v <= MAX_COUNT:
         return v
-    raise MessageError(f"{where}: expected a count (0 <= int < 2**53), got {v!r}"[:200])
+    raise MessageError(f"{where}: expected a count (0 to {MAX_COUNT}), got {v!r}"[:200])
 
 
 def _one_of(choices, convert, v, where):
@@ -295,5 +298,5 @@ def _schema_of(hint) -> dict:
             "additionalProperties": False,
         }
     if hint is int:
-        return {"type": "integer", "minimum": 0, "maximum": 2**53 - 1}
+        return {"type": "integer", "minimum": 0, "maximum": MAX_COUNT}
     return {"type": {float: "number", str: "string", bool: "boolean"}[hint]}

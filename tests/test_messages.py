@@ -80,6 +80,7 @@ def test_schemas_reject_what_the_decoder_rejects():
             "AgvState.vx: expected a finite",
         ),
         (json.dumps(to_dict(STATE) | {"tick": -1}).encode(), "AgvState.tick: expected a count"),
+        (json.dumps(to_dict(STATE) | {"tick": 2**31}).encode(), "AgvState.tick: expected a count"),
         (json.dumps(to_dict(STATE) | {"status": "teleported"}).encode(), "not one of driving"),
         (json.dumps(to_dict(STATE) | {"name": "b"}).encode(), "names AGV 'b'"),
         (b"[" * 100_000 + b"]" * 100_000, "nested too deeply"),
