@@ -48,7 +48,7 @@ def decode(key: str, payload: bytes):
         raise MessageError("JSON nested too deeply") from None
     msg = from_dict(cls, data)
     owner = keys.agv_name(key)
-    if owner is not None and msg.name != owner:
+    if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
     return msg
 
