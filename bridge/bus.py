@@ -1,7 +1,10 @@
 """Typed publish/subscribe on a run's keys, with a codec that never crashes a node.
 
-Payloads are compact JSON of ``bridge.messages`` types. A payload that fails
-to decode or validate is counted per key and logged once per key (to the
+Payloads are compact JSON of ``bridge.messages`` types. Every payload is
+validated before anyone sees it: its size (``MAX_PAYLOAD_BYTES``), JSON
+nesting (Python's parser stops at its recursion limit), every field's type,
+finite numbers, list lengths, and that a message on ``agv/<name>/...`` names
+that AGV. One that fails is counted per key and logged once per key (to the
 node's stderr); the node goes on. Subscribers deliver into a queue so a node
 can wait with a timeout (``recv()`` of zenoh handlers has none).
 """
@@ -18,6 +21,12 @@ import zenoh
 
 from bridge import keys
 from bridge.messages import MessageError, from_dict, to_dict
+from bridge.session import MAX_MESSAGE_BYTES
+
+MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
+# keys counted one by one; past that, under OTHER_KEYS (a forger picks the keys)
+MAX_COUNTED_KEYS = 1000
+OTHER_KEYS = "(other keys)"
 
 
 def encode(msg) -> bytes:
@@ -28,12 +37,20 @@ def decode(key: str, payload: bytes):
     """The message a relative key carries, decoded and validated (MessageError if not)."""
     cls = keys.message_type(key)
     if cls is None:
-        raise MessageError(f"no message type for key {key!r}")
+        raise MessageError("no message type for this key")
+    if len(payload) > MAX_PAYLOAD_BYTES:
+        raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
     try:
         data = json.loads(payload)
     except (ValueError, UnicodeDecodeError) as err:
-        raise MessageError(f"not JSON: {err}") from None
-    return from_dict(cls, data)
+        raise MessageError(f"not JSON: {err}"[:200]) from None
+    except RecursionError:
+        raise MessageError("JSON nested too deeply") from None
+    msg = from_dict(cls, data)
+    owner = keys.agv_name(key)
+    if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
+        raise MessageError(f"names AGV {msg.name!r}"[:200])
+    return msg
 
 
 @dataclass
@@ -49,7 +66,7 @@ class Bus:
     def __init__(self, session: zenoh.Session, prefix: str):
         self.session = session
         self.prefix = prefix
-        self.malformed: Counter[str] = Counter()
+        self.invalid: Counter[str] = Counter()
         self._publishers: dict[str, zenoh.Publisher] = {}
         self._keep: list = []  # subscribers live as long as their Python objects
 
@@ -71,40 +88,43 @@ class Bus:
             self._publishers[key] = pub
         pub.put(payload)
 
-    def subscribe(self, key_expr: str, decoded: bool = True) -> queue.Queue:
-        """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``.
-
-        With ``decoded=False`` the queue gets raw payloads (``msg`` is None),
-        for the recorder, which stores them as they came.
-        """
+    def subscribe(self, key_expr: str) -> queue.Queue:
+        """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
+        (with its payload as it came, which the recorder stores)."""
         q: queue.Queue = queue.Queue()
 
         def on_sample(sample: zenoh.Sample) -> None:
             key = self.relative(sample.key_expr)
             payload = sample.payload.to_bytes()
-            if not decoded:
-                q.put(Received(key, None, payload))
-                return
             try:
                 msg = decode(key, payload)
             except MessageError as err:
-                self._count_malformed(key, err)
+                self.count_invalid(key, err)
                 return
             q.put(Received(key, msg, payload))
 
         self._keep.append(self.session.declare_subscriber(self.full(key_expr), on_sample))
         return q
 
-    def _count_malformed(self, key: str, err: Exception) -> None:
-        self.malformed[key] += 1
-        if self.malformed[key] == 1:
-            print(f"agv-fleet: ignoring malformed message on {key}: {err}", file=sys.stderr)
+    def count_invalid(self, key: str, why) -> None:
+        """Count a message that was not used (a node's own checks call this too)."""
+        if key not in self.invalid and len(self.invalid) >= MAX_COUNTED_KEYS:
+            key = OTHER_KEYS
+        self.invalid[key] += 1
+        if self.invalid[key] == 1:
+            shown = key if len(key) <= 100 else key[:100] + "..."
+            print(f"agv-fleet: ignoring invalid message on {shown}: {why}", file=sys.stderr)
 
     # --- liveliness -------------------------------------------------------------------
     def declare_alive(self, key: str) -> zenoh.LivelinessToken:
         token = self.session.liveliness().declare_token(self.full(key))
         self._keep.append(token)
         return token
+
+    def is_alive(self, key: str, timeout: float = 2.0) -> bool:
+        """Whether a liveliness token on ``key`` exists now (a query to the router)."""
+        replies = self.session.liveliness().get(self.full(key), timeout=timeout)
+        return any(reply.ok is not None for reply in replies)
 
     def watch_alive(self, key_expr: str) -> queue.Queue:
         """A queue of (relative key, alive: bool) for tokens on ``key_expr``, present ones first."""

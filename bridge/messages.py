@@ -14,7 +14,15 @@ import types
 import typing
 from dataclasses import dataclass, field
 
+from planner.agv_status import STATUSES
 from planner.errors import BadInputError
+
+# No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
+# a decoded message is bounded however it was made.
+MAX_LIST_ITEMS = 1_000_000
+# No count in a message is larger (a run has at most a few million ticks, a map a few
+# million cells); a tick times the longest dt in nanoseconds still fits an MCAP log time.
+MAX_COUNT = 2**31 - 1
 
 
 @dataclass
@@ -148,6 +156,9 @@ class ResultMsg:
     summary: str
 
 
+# string fields that take one of a few values
+CHOICES = {(AgvState, "status"): STATUSES, (AgvCommand, "status"): STATUSES}
+
 MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event, ResultMsg)
 
 
@@ -199,7 +210,10 @@ def _decoder(cls):
     specs = []
     for f in dataclasses.fields(cls):
         required = f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-        specs.append((f.name, required, _converter(hints[f.name])))
+        convert = _converter(hints[f.name])
+        if (cls, f.name) in CHOICES:
+            convert = functools.partial(_one_of, CHOICES[cls, f.name], convert)
+        specs.append((f.name, required, convert))
     names = {f.name for f in dataclasses.fields(cls)}
 
     def decode(data, where):
@@ -233,6 +247,8 @@ def _converter(hint):
         def convert_list(v, where):
             if not isinstance(v, list):
                 raise MessageError(f"{where}: expected a list")
+            if len(v) > MAX_LIST_ITEMS:
+                raise MessageError(f"{where}: {len(v)} items, more than {MAX_LIST_ITEMS}")
             return [convert_item(x, where) for x in v]
 
         return convert_list
@@ -240,20 +256,44 @@ def _converter(hint):
         return _decoder(hint)
     if hint is float:
         return _to_float
-    if hint in (int, str, bool):
+    if hint is int:
+        return _natural
+    if hint in (str, bool):
         return functools.partial(_exactly, hint)
     raise TypeError(f"unsupported field type {hint!r}")
 
 
+_FLOAT_INT = 2**1023  # ints beyond any float's range do not convert
+
+
 def _to_float(v, where):
-    if type(v) is float or (type(v) is int):
+    """A finite number: JSON from Python may carry NaN and Infinity, and one NaN pose
+    would run through the planner and every later tick."""
+    if type(v) is float:
+        if v - v == 0.0:  # not for NaN or an infinity (a call to math.isfinite costs more)
+            return v
+    elif type(v) is int and -_FLOAT_INT < v < _FLOAT_INT:
         return float(v)
-    raise MessageError(f"{where}: expected a number, got {v!r}")
+    raise MessageError(f"{where}: expected a finite number, got {v!r}"[:200])
+
+
+def _natural(v, where):
+    """Every integer of a message counts something (ticks, cells, turns)."""
+    if type(v) is int and 0 <= v <= MAX_COUNT:
+        return v
+    raise MessageError(f"{where}: expected a count (0 to {MAX_COUNT}), got {v!r}"[:200])
+
+
+def _one_of(choices, convert, v, where):
+    v = convert(v, where)
+    if v not in choices:
+        raise MessageError(f"{where}: {v!r} is not one of {', '.join(choices)}"[:200])
+    return v
 
 
 def _exactly(kind, v, where):
     if type(v) is not kind:
-        raise MessageError(f"{where}: expected {kind.__name__}, got {v!r}")
+        raise MessageError(f"{where}: expected {kind.__name__}, got {v!r}"[:200])
     return v
 
 
@@ -275,9 +315,13 @@ def _schema_of(hint) -> dict:
     if dataclasses.is_dataclass(hint):
         hints = typing.get_type_hints(hint)
         fields = dataclasses.fields(hint)
+        properties = {f.name: _schema_of(hints[f.name]) for f in fields}
+        for (cls, name), choices in CHOICES.items():
+            if cls is hint:
+                properties[name] = {"type": "string", "enum": list(choices)}
         return {
             "type": "object",
-            "properties": {f.name: _schema_of(hints[f.name]) for f in fields},
+            "properties": properties,
             "required": [
                 f.name
                 for f in fields
@@ -285,4 +329,6 @@ def _schema_of(hint) -> dict:
             ],
             "additionalProperties": False,
         }
-    return {"type": {float: "number", int: "integer", str: "string", bool: "boolean"}[hint]}
+    if hint is int:
+        return {"type": "integer", "minimum": 0, "maximum": MAX_COUNT}
+    return {"type": {float: "number", str: "string", bool: "boolean"}[hint]}

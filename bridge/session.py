@@ -5,7 +5,9 @@ endpoint (a Unix socket in a new temporary folder by default, or a free
 ``tcp/127.0.0.1`` port), multicast and gossip scouting are off, shared memory
 is off (it leaves files in /dev/shm when a process is killed) and every key
 lives under a per-run prefix. A short lease (1 s) makes a dead or hung peer
-visible to liveliness subscribers within about a second.
+visible to liveliness subscribers within about a second. Messages larger
+than ``MAX_MESSAGE_BYTES`` are dropped by Zenoh itself, before any buffer
+grows for them. Who may join and publish what is ``bridge.trust``'s.
 """
 
 from __future__ import annotations
@@ -16,12 +18,16 @@ import socket
 import tempfile
 import time
 import uuid
+from dataclasses import dataclass
 
 import zenoh
 
 from planner.errors import EnvironmentFailure
 
 LEASE_MS = 1000
+# far above the largest message of a run (the map of a MAX_MAP_CELLS map, ~MAX_MAP_CELLS
+# bytes); a larger one is dropped when it arrives: 50 MB messages cost memory in every node
+MAX_MESSAGE_BYTES = 16 * 1024 * 1024
 CONNECT_ATTEMPT_MS = 500
 # A client (one AGV) needs one thread per Zenoh runtime: with the default pools,
 # 50 AGV processes on 2 cores spend a third of their CPU on idle runtime threads.
@@ -43,11 +49,11 @@ def run_prefix(run_id: str) -> str:
     return f"agv-fleet/{run_id}"
 
 
-def fresh_endpoint(transport: str = "unix") -> str:
-    """A listen endpoint nobody else uses: a Unix socket in a new temporary
-    folder, or a free TCP port on 127.0.0.1 (``transport="tcp"``)."""
+def fresh_endpoint(transport: str = "unix", folder: str | None = None) -> str:
+    """A listen endpoint nobody else uses: a Unix socket in ``folder`` (default: a new
+    temporary folder), or a free TCP port on 127.0.0.1 (``transport="tcp"``)."""
     if transport == "unix":
-        folder = tempfile.mkdtemp(prefix="agv-fleet-")
+        folder = folder or tempfile.mkdtemp(prefix="agv-fleet-")
         return f"unixsock-stream/{os.path.join(folder, 'zenoh.sock')}"
     if transport == "tcp":
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
@@ -70,12 +76,31 @@ def _set(config: zenoh.Config, key: str, value) -> None:
     config.insert_json5(key, json.dumps(value))
 
 
+@dataclass(frozen=True)
+class Login:
+    """A client's Zenoh user and password (see bridge.trust)."""
+
+    user: str
+    password: str
+
+
+@dataclass(frozen=True)
+class Guard:
+    """What a router enforces: the users it admits (a ``user:password`` dictionary
+    file) and the access control for them."""
+
+    dictionary_file: str
+    access_control: dict
+
+
 def make_config(
     mode: str,
     *,
     listen: list[str] = (),
     connect: list[str] = (),
     config_file: str | None = None,
+    login: Login | None = None,
+    guard: Guard | None = None,
 ) -> zenoh.Config:
     """A router or client config; a user's config file (TLS, auth, ...) is the base."""
     config = _base_config(config_file)
@@ -86,28 +111,58 @@ def make_config(
     _set(config, "scouting/gossip/enabled", False)
     _set(config, "transport/shared_memory/enabled", False)
     _set(config, "transport/link/tx/lease", LEASE_MS)
+    _set(config, "transport/link/rx/max_message_size", MAX_MESSAGE_BYTES)
+    if login:
+        _set(config, "transport/auth/usrpwd/user", login.user)
+        _set(config, "transport/auth/usrpwd/password", login.password)
+    if guard:
+        _set(config, "transport/auth/usrpwd/dictionary_file", guard.dictionary_file)
+        _set(config, "access_control", guard.access_control)
     if mode == "client":
         _set(config, "connect/timeout_ms", CONNECT_ATTEMPT_MS)
     return config
 
 
-def open_router(listen: str, config_file: str | None = None) -> zenoh.Session:
+def has_authentication(config_file: str | None) -> bool:
+    """Whether a user's Zenoh config sets user/password authentication or TLS."""
+    if not config_file:
+        return False
+    config = _base_config(config_file)
+    keys = ("transport/auth/usrpwd/dictionary_file", "transport/link/tls/listen_certificate")
+    return any(config.get_json(key) not in ("null", '""') for key in keys)
+
+
+def open_router(
+    listen: str, config_file: str | None = None, guard: Guard | None = None
+) -> zenoh.Session:
     try:
-        return zenoh.open(make_config("router", listen=[listen], config_file=config_file))
+        return zenoh.open(
+            make_config("router", listen=[listen], config_file=config_file, guard=guard)
+        )
     except zenoh.ZError as err:
         raise BusError(f"cannot listen on {listen}: {err}") from None
 
 
 def open_client(
-    connect: str, timeout: float = 30.0, config_file: str | None = None
+    connect: str,
+    timeout: float = 30.0,
+    config_file: str | None = None,
+    login: Login | None = None,
 ) -> zenoh.Session:
-    """Connect to the router, retrying until ``timeout`` so start order does not matter."""
+    """Connect to the router, retrying until ``timeout`` so start order does not matter.
+
+    A router that refuses the login looks like no router at all to Zenoh, so the
+    error names both causes."""
     os.environ.setdefault("ZENOH_RUNTIME", CLIENT_RUNTIME)  # read when the runtime starts
+    config = make_config("client", connect=[connect], config_file=config_file, login=login)
     deadline = time.monotonic() + timeout
     while True:
         try:
-            return zenoh.open(make_config("client", connect=[connect], config_file=config_file))
-        except zenoh.ZError as err:
+            return zenoh.open(config)
+        except zenoh.ZError:
             if time.monotonic() >= deadline:
-                raise BusError(f"no router at {connect} after {timeout:g} s: {err}") from None
+                raise BusError(
+                    f"no router at {connect} accepted this process within {timeout:g} s "
+                    "(none listening, or it refused these credentials)"
+                ) from None
             time.sleep(0.05)

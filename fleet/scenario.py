@@ -30,6 +30,7 @@ from planner.costmap import point_clearance
 from planner.dwa import DwaConfig
 from planner.fusion import VARIANTS, FusionConfig
 from planner.grid_map import GridMap, MapError
+from planner.limits import read_input_file
 from planner.map_io import UNKNOWN_CHOICES, load_map, parse_text_grid
 from planner.profiles import DEFAULT, PROFILES
 from planner.random_map import random_map
@@ -38,6 +39,10 @@ TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
     "map", "planner", "agv_defaults", "agvs", "obstacles",
 )  # fmt: skip
+# the control period (s) and the longest run (s): at most 3.6 million ticks, and no
+# run whose clock never reaches its end (a dt of 1e-9 was accepted)
+DT_RANGE = (0.01, 1.0)
+MAX_TIME_LIMIT = 36_000.0
 MAP_KEYS = ("resolution", "grid", "file", "random", "unknown")
 RANDOM_KEYS = ("width", "height", "obstacle_ratio", "seed")
 # [planner]: TOML key -> (FusionConfig or DwaConfig field, scale to internal units)
@@ -127,7 +132,9 @@ def resolve_scenario(name_or_path: str) -> Path:
 def load_scenario(name_or_path: str | Path) -> Scenario:
     path = resolve_scenario(str(name_or_path))
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_input_file(path, "scenario").decode("utf-8")
+    except MapError as err:
+        raise ScenarioError(str(err)) from None
     except (OSError, UnicodeDecodeError) as err:
         raise ScenarioError(f"cannot read scenario {path}: {err}") from None
     return parse_scenario(text, path)
@@ -141,7 +148,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         raise ScenarioError(f"{where}: not valid TOML: {err}") from None
     check_keys(doc, TOP_KEYS, "")
     name = get_str(doc, "name", "", default=path.stem if path else "scenario")
-    dt = get_number(doc, "dt", "", default=0.1, positive=True)
+    dt = get_number(doc, "dt", "", default=0.1, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
     profile = get_str(doc, "profile", "", default=DEFAULT, choices=PROFILES)
     grid = _parse_map(get_table(doc, "map", "", required=True), path, name, doc)
     planner_defaults = get_table(doc, "planner", "")
@@ -154,7 +161,9 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         name=name,
         description=get_str(doc, "description", "", default=""),
         dt=dt,
-        time_limit=get_number(doc, "time_limit", "", default=300.0, positive=True),
+        time_limit=get_number(
+            doc, "time_limit", "", default=300.0, positive=True, maximum=MAX_TIME_LIMIT
+        ),
         sensing_radius=get_number(doc, "sensing_radius", "", default=5.0, minimum=0.0),
         grid=grid,
         agvs=agvs,
@@ -197,9 +206,11 @@ def _parse_map(table: dict, path: Path | None, name: str, doc: dict) -> GridMap:
             if isinstance(agv, dict) and key in agv:
                 x, y = as_point(agv[key], f"agvs[{i}].{key}")
                 keep.append((math.floor(x / res), math.floor(y / res)))
-    return random_map(
-        width, height, ratio, get_int(spec, "seed", "map.random", default=0), keep, res
-    )
+    seed = get_int(spec, "seed", "map.random", default=0)
+    try:
+        return random_map(width, height, ratio, seed, keep, res)
+    except MapError as err:
+        raise ScenarioError(f"map: {err}") from None
 
 
 def _parse_config(

@@ -60,6 +60,7 @@ def get_number(
     default=_MISSING,
     minimum: float | None = None,
     positive: bool = False,
+    maximum: float | None = None,
 ) -> float:
     value = table.get(key, default)
     if value is _MISSING:
@@ -70,6 +71,8 @@ def get_number(
         raise ScenarioError(f"{_join(where, key)} must be > 0, got {value!r}")
     if minimum is not None and value < minimum:
         raise ScenarioError(f"{_join(where, key)} must be >= {minimum:g}, got {value!r}")
+    if maximum is not None and value > maximum:
+        raise ScenarioError(f"{_join(where, key)} must be <= {maximum:g}, got {value!r}")
     return float(value)
 
 

@@ -6,4 +6,5 @@ DRIVING = "driving"
 BLOCKED = "blocked"  # no admissible command this cycle: braking
 ARRIVED = "arrived"
 FAILED = "failed"
+STATUSES = (DRIVING, BLOCKED, ARRIVED, FAILED)
 FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run

@@ -18,6 +18,7 @@ import numpy as np
 import yaml
 
 from planner.grid_map import GridMap, MapError
+from planner.limits import check_map_cells, read_input_file
 
 MOVINGAI_FREE = frozenset(".GS")
 MOVINGAI_BLOCKED = frozenset("@OTW")
@@ -27,7 +28,7 @@ ROS_MODES = ("trinary", "scale", "raw")
 # --- shared helpers --------------------------------------------------------------------
 def _read_bytes(path: Path, what: str = "map file") -> bytes:
     try:
-        return path.read_bytes()
+        return read_input_file(path, what)
     except FileNotFoundError:
         raise MapError(f"{what} not found: {path}") from None
     except OSError as err:
@@ -61,6 +62,7 @@ def _text_rows(text: str, where: str) -> np.ndarray:
     if not numbered:
         raise MapError(f"{where}: no grid rows")
     width = len(numbered[0][1])
+    check_map_cells(width, len(numbered), where)
     for lineno, line in numbered:
         if len(line) != width:
             raise MapError(
@@ -102,6 +104,7 @@ def _matrix_rows(text: str, path: Path) -> np.ndarray:
                 f"expected {len(rows[0])} like line {first_lineno}"
             )
         rows.append([t == "1" for t in tokens])
+        check_map_cells(len(tokens), len(rows), str(path))
     if not rows:
         raise MapError(f"{path}: no grid rows (only comments or blank lines)")
     return np.array(rows, dtype=bool)
@@ -155,6 +158,7 @@ def _movingai_header(lines: list[str], path: Path) -> tuple[int, int, int]:
                 f"{path}: bad MovingAI header: {key} {value!r} is not a positive integer"
             )
         sizes.append(int(value))
+    check_map_cells(sizes[1], sizes[0], str(path))
     return sizes[0], sizes[1], i + 1
 
 
@@ -324,6 +328,7 @@ def _read_pgm(path: str | os.PathLike) -> tuple[np.ndarray, int]:
     magic, width, height, maxval = match[1], int(match[2]), int(match[3]), int(match[4])
     if width == 0 or height == 0 or not 0 < maxval < 65536:
         raise MapError(f"{path}: bad PGM header: size {width}x{height}, maxval {maxval}")
+    check_map_cells(width, height, str(path))
     count = width * height
     if magic == b"P5":
         dtype = np.dtype("u1" if maxval < 256 else ">u2")

@@ -8,6 +8,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from planner.grid_map import Cell, GridMap
+from planner.limits import check_map_cells
 
 
 def random_map(
@@ -31,6 +32,7 @@ def random_map(
     if not (isinstance(obstacle_ratio, numbers.Real) and 0 <= obstacle_ratio < 1):
         raise ValueError(f"random map obstacle_ratio must be in [0, 1), got {obstacle_ratio!r}")
     width, height = int(width), int(height)
+    check_map_cells(width, height, "random map")
     kept = {row * width + col for col, row in keep_free if 0 <= col < width and 0 <= row < height}
     candidates = np.setdiff1d(np.arange(width * height), np.fromiter(kept, int, len(kept)))
     count = round(obstacle_ratio * width * height)

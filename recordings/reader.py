@@ -10,6 +10,13 @@ Messages come in file order (the order they were recorded, which is causal:
 an AGV's state for tick k+1 comes before its plan made at tick k), not sorted
 by log time. Reading does not decode them: each message's JSON is decoded on
 first use, so ``info`` decodes nothing and ``analyze`` only the topics it uses.
+
+A recording is input like any other: a message on one of the run's topics
+that is not valid for its message type (``bridge.messages``: fields, types,
+finite numbers, sizes) is undecodable and skipped (and counted), never handed
+on; other topics give any JSON object. Only regular files of at most
+``MAX_RECORDING_BYTES`` are read (a FIFO would hang the reader); a cut file
+from which nothing could be recovered is an error.
 """
 
 from __future__ import annotations
@@ -31,16 +38,25 @@ from mcap.records import Attachment, Channel, Chunk, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import MCAP0_MAGIC
 
-from bridge.keys import agv_name
+from bridge.keys import agv_name, message_type
+from bridge.messages import MessageError, from_dict
 from planner.errors import BadInputError
+from planner.grid_map import MapError
+from planner.limits import open_regular_file
 
 # what mcap raises on a cut or damaged file: its own errors, short reads in struct,
 # CRC mismatches (ValueError), unknown ids (KeyError) and bad compressed data
 _DAMAGED = (McapError, struct.error, ValueError, KeyError, EOFError, zstandard.ZstdError)
 
 
+# what ``open_recording`` reads: messages are held decompressed in memory, about ten
+# times the size of their zstd chunks
+MAX_RECORDING_BYTES = 1024**3
+
+
 class RecordingError(BadInputError):
-    """A file that cannot be read as a recording at all (missing, not MCAP)."""
+    """A file that cannot be read as a recording at all (missing, not MCAP, too large,
+    nothing recoverable)."""
 
 
 _UNDECODED = object()
@@ -63,7 +79,7 @@ class RecordedMessage:
     @property
     def data(self) -> dict | None:
         if self._data is _UNDECODED:
-            self._data = _decode(self.payload)
+            self._data = _decode(self.topic, self.payload)
         return self._data
 
     @property
@@ -74,7 +90,9 @@ class RecordedMessage:
         return f"RecordedMessage({self.topic!r}, {self.log_time_ns}, {len(self.payload)} bytes)"
 
 
-def _decode(payload: bytes) -> dict | None:
+def _decode(topic: str, payload: bytes) -> dict | None:
+    """The JSON object of a message, if valid for its topic's message type (any JSON
+    object on a topic that has none), else None."""
     try:
         text = payload.decode()
         data, end = _raw_decode(text)
@@ -83,9 +101,18 @@ def _decode(payload: bytes) -> dict | None:
     except ValueError:  # UnicodeDecodeError, JSONDecodeError, leading whitespace
         try:
             data = json.loads(payload)
-        except ValueError:
+        except (ValueError, RecursionError):
             return None
-    return data if isinstance(data, dict) else None
+    except RecursionError:
+        return None
+    cls = message_type(topic)
+    if cls is None:
+        return data if isinstance(data, dict) else None
+    try:
+        from_dict(cls, data)
+    except MessageError:
+        return None
+    return data
 
 
 @dataclass
@@ -119,7 +146,7 @@ class Recording:
             if m.decoded:
                 data = m.data
             else:
-                data = _decode(m.payload)
+                data = _decode(m.topic, m.payload)
                 if data is None:
                     m._data = None  # remembered for ``undecodable``
             if data is not None:
@@ -188,7 +215,12 @@ def open_recording(path) -> Recording:
     """Read a whole recording; RecordingError if it is missing or not MCAP."""
     path = Path(path)
     try:
-        with open(path, "rb") as f:
+        with open_regular_file(path, "recording") as f:
+            if os.fstat(f.fileno()).st_size > MAX_RECORDING_BYTES:
+                raise RecordingError(
+                    f"{path} is larger than the {MAX_RECORDING_BYTES // 2**20} MiB "
+                    "a recording may have"
+                )
             if f.read(len(MCAP0_MAGIC)) != MCAP0_MAGIC:
                 raise RecordingError(f"{path} is not an MCAP recording (bad magic bytes)")
             f.seek(-len(MCAP0_MAGIC), os.SEEK_END)
@@ -204,6 +236,8 @@ def open_recording(path) -> Recording:
                 return _read_stream(f, path)
     except FileNotFoundError:
         raise RecordingError(f"no such file: {path}") from None
+    except MapError as err:  # not a regular file
+        raise RecordingError(str(err)) from None
     except OSError as err:
         raise RecordingError(f"cannot read {path}: {err.strerror or err}") from None
 
@@ -278,4 +312,6 @@ def _read_stream(f, path: Path) -> Recording:
     else:  # a whole file whose summary or index could not be used
         why, truncated = "summary unusable, read sequentially", False
     note = f"{why}: recovered {chunks} complete chunks, {len(messages)} messages"
+    if truncated and not (messages or metadata or attachments):
+        raise RecordingError(f"{path}: {why}, and nothing could be recovered from it")
     return Recording(path, messages, metadata, attachments, topics, truncated, note)

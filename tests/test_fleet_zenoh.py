@@ -149,7 +149,7 @@ def test_malformed_payloads_are_counted_and_ignored():
                 session.put(bus.full(keys.agv_command("left")), payload)
             time.sleep(0.2)
         runner.join(timeout=120)
-    assert bus.malformed[keys.agv_command("left")] == 3
+    assert bus.invalid[keys.agv_command("left")] == 3
     assert result["summary"].success
     alone = run_in_process(load_scenario("corridor")).to_json()
     assert result["summary"].to_json()["agvs"] == alone["agvs"]

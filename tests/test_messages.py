@@ -8,8 +8,9 @@ import jsonschema
 import pytest
 
 from bridge import keys
-from bridge.bus import decode, encode
+from bridge.bus import MAX_PAYLOAD_BYTES, decode, encode
 from bridge.messages import (
+    MAX_LIST_ITEMS,
     MESSAGE_TYPES,
     AgvState,
     Event,
@@ -57,7 +58,7 @@ def test_schemas_reject_what_the_decoder_rejects():
     bad = to_dict(STATE) | {"x": "far"}
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(bad, schema)
-    with pytest.raises(MessageError, match=r"AgvState.x: expected a number"):
+    with pytest.raises(MessageError, match=r"AgvState.x: expected a finite number"):
         decode(keys.agv_state("a"), json.dumps(bad).encode())
 
 
@@ -68,13 +69,35 @@ def test_schemas_reject_what_the_decoder_rejects():
         (b"[]", "expected an object"),
         (b'{"name": "a"}', "missing field 'tick'"),
         (json.dumps(to_dict(STATE) | {"extra": 1}).encode(), "unknown field 'extra'"),
-        (json.dumps(to_dict(STATE) | {"tick": 2.5}).encode(), "AgvState.tick: expected int"),
-        (json.dumps(to_dict(STATE) | {"target": [1, "x"]}).encode(), "expected a number"),
+        (json.dumps(to_dict(STATE) | {"tick": 2.5}).encode(), "AgvState.tick: expected a count"),
+        (json.dumps(to_dict(STATE) | {"target": [1, "x"]}).encode(), "expected a finite number"),
+        (
+            json.dumps(to_dict(STATE) | {"x": float("nan")}).encode(),
+            "AgvState.x: expected a finite",
+        ),
+        (
+            json.dumps(to_dict(STATE) | {"vx": float("inf")}).encode(),
+            "AgvState.vx: expected a finite",
+        ),
+        (json.dumps(to_dict(STATE) | {"tick": -1}).encode(), "AgvState.tick: expected a count"),
+        (json.dumps(to_dict(STATE) | {"tick": 2**31}).encode(), "AgvState.tick: expected a count"),
+        (json.dumps(to_dict(STATE) | {"status": "teleported"}).encode(), "not one of driving"),
+        (json.dumps(to_dict(STATE) | {"name": "b"}).encode(), "names AGV 'b'"),
+        (b"[" * 100_000 + b"]" * 100_000, "nested too deeply"),
+        (b" " * (MAX_PAYLOAD_BYTES + 1), "more than"),
     ],
 )
 def test_malformed_payloads_raise_message_errors(payload, message):
     with pytest.raises(MessageError, match=message):
         decode(keys.agv_state("a"), payload)
+
+
+def test_foreign_keys_and_over_long_lists_are_refused():
+    with pytest.raises(MessageError, match="no message type"):
+        decode("agv/a/elsewhere", encode(STATE))
+    many = json.dumps(to_dict(STATE) | {"target": [0.0] * (MAX_LIST_ITEMS + 1)}).encode()
+    with pytest.raises(MessageError, match="more than"):
+        decode(keys.agv_state("a"), many)
 
 
 def test_a_real_tick_round_trips():

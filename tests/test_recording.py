@@ -133,6 +133,9 @@ def _check(schema: dict, value, where: str) -> None:
     assert isinstance(value, python) and not (
         kind in ("integer", "number") and isinstance(value, bool)
     ), f"{where}: {value!r} is not {kind}"
+    assert value in schema.get("enum", [value]), f"{where}: {value!r} is not a choice"
+    if "minimum" in schema:
+        assert value >= schema["minimum"], f"{where}: {value!r} is below the minimum"
     if kind == "object":
         assert set(schema["required"]) <= set(value), f"{where}: missing fields"
         assert set(value) <= set(schema["properties"]), f"{where}: extra fields"

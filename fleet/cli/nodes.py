@@ -9,12 +9,22 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import sys
 from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import open_client, open_router
+from bridge.session import Guard, Login, has_authentication, open_client, open_router
+from bridge.trust import (
+    CREDENTIALS_ENV,
+    RECORDER_USER,
+    agv_user,
+    exposure_warning,
+    guard_from,
+    login_from,
+)
 from fleet import exit_codes
-from fleet.cli.arguments import positive_float
+from fleet.cli.arguments import UsageError, positive_float
 from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
@@ -34,6 +44,16 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
     p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
     p.add_argument("--profile", choices=PROFILES, help="override the scenario's planner profile")
+    p.add_argument(
+        "--credentials",
+        metavar="FILE",
+        default=os.environ.get(CREDENTIALS_ENV),
+        help=(
+            "the run's Zenoh users, 'user:password' lines: the world admits only them "
+            "(and writes FILE with fresh ones if it does not exist); an AGV or the recorder "
+            f"logs in with its own (default: ${CREDENTIALS_ENV})"
+        ),
+    )
 
 
 def add_parsers(sub) -> None:
@@ -109,9 +129,27 @@ def _scenario(args):
     return scenario, args.prefix or f"agv-fleet/{scenario.name}"
 
 
+def _guard(args, scenario, prefix) -> Guard | None:
+    if not args.credentials:
+        return None
+    guard, created = guard_from(args.credentials, [a.name for a in scenario.agvs], prefix)
+    if created:
+        print(f"agv-fleet world: wrote new credentials to {args.credentials}", file=sys.stderr)
+    return guard
+
+
+def _login(args, user: str) -> Login | None:
+    return login_from(args.credentials, user) if args.credentials else None
+
+
 def run_world(args: argparse.Namespace) -> int:
     scenario, prefix = _scenario(args)
-    with open_router(args.listen, args.zenoh_config) as session:
+    guard = _guard(args, scenario, prefix)
+    secured = guard is not None or has_authentication(args.zenoh_config)
+    warning = exposure_warning(args.listen, secured)
+    if warning:
+        print(f"agv-fleet world: {warning}", file=sys.stderr)
+    with open_router(args.listen, args.zenoh_config, guard) as session:
         server = WorldServer(
             scenario,
             Bus(session, prefix),
@@ -127,8 +165,11 @@ def run_world(args: argparse.Namespace) -> int:
 
 def run_agv(args: argparse.Namespace) -> int:
     scenario, prefix = _scenario(args)
-    for name in args.name:
+    for i, name in enumerate(args.name):
         scenario.agv(name)
+        if name in args.name[:i]:
+            raise UsageError(f"--name {name} is given twice")
+    logins = {name: _login(args, agv_user(name)) for name in args.name}
     return serve_agvs(
         scenario,
         args.name,
@@ -136,6 +177,7 @@ def run_agv(args: argparse.Namespace) -> int:
         prefix,
         connect_timeout=args.connect_timeout,
         zenoh_config=args.zenoh_config,
+        logins=logins,
     )
 
 
@@ -150,8 +192,9 @@ def run_record(args: argparse.Namespace) -> int:
     }
     if args.run_id:
         facts["run_id"] = args.run_id
+    login = _login(args, RECORDER_USER)
     with (
-        open_client(args.connect, args.connect_timeout, args.zenoh_config) as session,
+        open_client(args.connect, args.connect_timeout, args.zenoh_config, login) as session,
         RecordingWriter(
             path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
         ) as writer,

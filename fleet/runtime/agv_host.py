@@ -20,7 +20,7 @@ import sys
 from setproctitle import setproctitle
 
 from bridge.bus import Bus
-from bridge.session import open_client
+from bridge.session import Login, open_client
 from fleet import exit_codes
 from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.agv_process import serve_agv
@@ -38,12 +38,16 @@ def serve_agvs(
     *,
     connect_timeout: float = 30.0,
     zenoh_config: str | None = None,
+    logins: dict[str, Login] | None = None,
 ) -> int:
-    """Run every named AGV, each in its own process; the worst exit status."""
+    """Run every named AGV, each in its own process (logged in as ``logins[name]``
+    when given); the worst exit status."""
     AgvNode(scenario, names[0]).warm_up()
+    logins = logins or {}
+    options = (connect, prefix, connect_timeout, zenoh_config)
     if len(names) == 1:
-        setproctitle(process_title(names[0]))
-        return _serve_one(scenario, names[0], connect, prefix, connect_timeout, zenoh_config)
+        _set_title(process_title(names[0]))
+        return _serve_one(scenario, names[0], *options, logins.get(names[0]))
     children: dict[int, str] = {}
     for name in names:
         pid = os.fork()
@@ -53,15 +57,22 @@ def serve_agvs(
                 signal.signal(signal.SIGINT, signal.SIG_DFL)
                 signal.signal(signal.SIGTERM, signal.SIG_DFL)
                 _prctl(_PR_SET_PDEATHSIG, signal.SIGTERM)
-                setproctitle(process_title(name))
-                code = _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config)
+                _set_title(process_title(name))
+                code = _serve_one(scenario, name, *options, logins.get(name))
             except BaseException as err:  # os._exit below would swallow it silently
                 print(f"agv-fleet agv {name}: crashed: {err!r}", flush=True, file=sys.stderr)
             finally:
                 os._exit(code)
         children[pid] = name
-    setproctitle(f"agv-fleet agv-host {scenario.name} ({len(names)} AGVs)")
+    _set_title(f"agv-fleet agv-host {scenario.name} ({len(names)} AGVs)")
     return _wait_for(children)
+
+
+def _set_title(title: str) -> None:
+    # SPT_NOENV: keep /proc/PID/environ intact (a title fits in the argv area of the
+    # host's long command line); it must be set before the first setproctitle call
+    os.environ.setdefault("SPT_NOENV", "1")
+    setproctitle(title)
 
 
 def process_title(name: str) -> str:
@@ -69,9 +80,9 @@ def process_title(name: str) -> str:
     return f"agv-fleet agv {name}"
 
 
-def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config) -> int:
+def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, login) -> int:
     try:
-        with open_client(connect, connect_timeout, zenoh_config) as session:
+        with open_client(connect, connect_timeout, zenoh_config, login) as session:
             serve_agv(scenario, name, Bus(session, prefix))
     except AgvFleetError as err:
         print(f"agv-fleet agv {name}: {err}", flush=True, file=sys.stderr)

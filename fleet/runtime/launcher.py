@@ -4,6 +4,10 @@ The AGV processes are started first (they retry connecting), then this
 process opens the router on a fresh endpoint and runs the world in it; so no
 process ever forks after it opened a Zenoh session. Every child is ended by
 PID on every way out: normal end, error, Ctrl-C or SIGTERM.
+
+Every run has its own credentials and access control (see bridge.trust): they
+live in a private temporary folder (with the Unix socket) that the children
+find through an environment variable, and that is removed at the end.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable
 from contextlib import contextmanager
@@ -21,6 +26,7 @@ from pathlib import Path
 
 from bridge.bus import Bus
 from bridge.session import fresh_endpoint, new_run_id, open_router, run_prefix
+from bridge.trust import CREDENTIALS_ENV, write_run_credentials
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
 from fleet.runtime.world_server import WorldServer
@@ -81,15 +87,24 @@ def run_fleet(
     sees every message of the bus, in this thread, after each tick (the live view)."""
     run_id = new_run_id()
     prefix = run_prefix(run_id)
-    endpoint = fresh_endpoint(options.transport)
+    run_dir = tempfile.mkdtemp(prefix="agv-fleet-")  # 0700: this user's only
+    endpoint = fresh_endpoint(options.transport, run_dir)
     children: list[subprocess.Popen] = []
     with _children_ended(children), _sigterm_as_interrupt():
         try:
             names = [agv.name for agv in scenario.agvs]
-            children.append(_spawn(agv_command(options, names, endpoint, prefix)))
+            guard, child_files = write_run_credentials(run_dir, names, prefix)
+            children.append(
+                _spawn(agv_command(options, names, endpoint, prefix), child_files["agvs"])
+            )
             if options.record_path:
-                children.append(_spawn(recorder_command(options, endpoint, prefix, run_id)))
-            with open_router(endpoint, options.zenoh_config) as session:
+                children.append(
+                    _spawn(
+                        recorder_command(options, endpoint, prefix, run_id),
+                        child_files["recorder"],
+                    )
+                )
+            with open_router(endpoint, options.zenoh_config, guard) as session:
                 bus = Bus(session, prefix)
                 if tap:
                     progress = _tapped(bus, tap, progress)
@@ -107,8 +122,7 @@ def run_fleet(
                     progress(server.world)  # the last messages, for the tap
                 return summary
         finally:
-            if endpoint.startswith("unixsock-stream/"):
-                shutil.rmtree(os.path.dirname(endpoint.split("/", 1)[1]), ignore_errors=True)
+            shutil.rmtree(run_dir, ignore_errors=True)
 
 
 def _tapped(bus: Bus, tap, progress):
@@ -135,10 +149,11 @@ def _exited_early(children: list[subprocess.Popen]) -> str | None:
     return None
 
 
-def _spawn(cmd: list[str]) -> subprocess.Popen:
+def _spawn(cmd: list[str], credentials_file: str) -> subprocess.Popen:
     # own process group: a Ctrl-C in the terminal reaches only the launcher, which
     # ends the children itself, in order
-    return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, start_new_session=True)
+    env = {**os.environ, CREDENTIALS_ENV: credentials_file}
+    return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, start_new_session=True, env=env)
 
 
 @contextmanager

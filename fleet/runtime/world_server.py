@@ -96,7 +96,9 @@ class WorldServer:
                 key, is_alive = self._liveliness.get(timeout=timeout)
                 timeout = 0.0
                 name = key.rsplit("/", 1)[-1]
-                if is_alive:
+                if name not in self.world.records:
+                    self.bus.count_invalid(key, "a liveliness token of no AGV of this run")
+                elif is_alive:
                     self.alive.add(name)
                 else:
                     self.alive.discard(name)
