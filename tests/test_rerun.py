@@ -11,6 +11,7 @@ import os
 import queue
 import re
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -27,11 +28,11 @@ from fleet.builtin import builtin_scenarios
 from fleet.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from recordings.reader import open_recording
-from recordings.rerun_rows import QUANTITIES, RowMaker, blocked_rectangles
+from recordings.rerun_rows import QUANTITIES, RowMaker
 from recordings.rerun_view import LiveView, Outputs, save_rrd
 from recordings.writer import RecordingWriter, record_sink
 
-AGV_PARTS = ("body", "heading", "trail", "plan", "plan/key_nodes", "dwa")
+AGV_PARTS = ("body", "heading", "label", "trail", "plan", "plan/key_nodes", "dwa", "pose")
 
 
 class Entity:
@@ -112,7 +113,17 @@ def test_a_saved_replay_has_the_map_every_agv_its_plans_and_velocities(corridor,
             series = replayed[f"/velocity/{q}/{name}"]
             assert len(series.rows) == len(states), q
             assert series.static == 1  # its name and colour in the plot
-    assert len(replayed["/events"].rows) == len(recording.of("world/event"))
+        assert replayed[f"/world/agv/{name}/start"].static >= 1  # its square, and style
+        assert replayed[f"/world/agv/{name}/goal"].static >= 1
+        assert len(replayed[f"/world/agv/{name}/pose"].rows) == len(ticks)  # the followed frame
+        assert len(replayed[f"/world/agv/{name}/label"].rows) == len(ticks)
+    world_events = [m.data["kind"] for m in recording.of("world/event")]
+    replans = [
+        m for n in names for m in recording.of(f"agv/{n}/plan") if m.data["reason"] != "initial"
+    ]
+    for kind in {*world_events, "replan"}:
+        expected = len(replans) if kind == "replan" else world_events.count(kind)
+        assert len(replayed.get(f"/events/{kind}", Entity()).rows) == expected, kind
 
 
 def test_velocity_rows_are_the_states_at_their_tick_time(corridor, replayed):
@@ -150,26 +161,62 @@ def test_the_live_view_shows_what_the_replay_shows(corridor, replayed):
         assert live[path].rows == entity.rows, path
 
 
-def test_blocked_cells_merge_into_rectangles_with_row_zero_at_the_bottom():
-    rows_top_down = ["#...", "##.#", "##.#"]
-    assert blocked_rectangles(rows_top_down) == [(0, 0, 2, 2), (0, 2, 1, 3), (3, 0, 4, 2)]
-
-
 def test_a_message_that_does_not_fit_its_topic_is_a_message_error():
     with pytest.raises(MessageError, match="world/tick"):
         RowMaker(0.1).feed("world/tick", {"tick": 0, "time": 0.0})
 
 
-def test_a_paced_replay_takes_its_time_and_sends_the_same_rows(corridor, replayed, tmp_path):
-    recording = corridor["recording"]
-    rate = 200.0
-    duration = recording.of("world/tick")[-1].data["time"] / rate
-    t0 = time.monotonic()
-    with Outputs(save=tmp_path / "paced.rrd") as out:
-        out.replay(recording, rate=rate)
-    assert time.monotonic() - t0 >= duration
-    paced = read_rrd(tmp_path / "paced.rrd")
-    assert {p: e.rows for p, e in paced.items()} == {p: e.rows for p, e in replayed.items()}
+def blueprint_values(path: Path, component: str) -> list:
+    """Every value of a blueprint component (e.g. ``TimePanelBlueprint:play_state``)."""
+    reader = RrdReader(str(path))
+    values = []
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        if component in batch.schema.names:
+            values += [v for v in batch.column(component).to_pylist() if v is not None]
+    return values
+
+
+PAUSED, PLAYING = [1], [2]  # rerun.blueprint.components.PlayState
+
+
+def test_a_replay_opens_paused_at_the_start_or_playing_at_its_rate(corridor, replayed, tmp_path):
+    with Outputs(save=tmp_path / "rate.rrd") as out:
+        out.replay(corridor["recording"], rate=4.0)
+    at_rate = read_rrd(tmp_path / "rate.rrd")
+    assert {p: e.rows for p, e in at_rate.items()} == {p: e.rows for p, e in replayed.items()}
+    assert blueprint_values(tmp_path / "rate.rrd", "TimePanelBlueprint:play_state") == [PLAYING]
+    assert blueprint_values(tmp_path / "rate.rrd", "TimePanelBlueprint:playback_speed") == [[4.0]]
+    save_rrd(corridor["recording"], tmp_path / "plain.rrd")
+    assert blueprint_values(tmp_path / "plain.rrd", "TimePanelBlueprint:play_state") == [PAUSED]
+
+
+def blueprint_entities(path: Path) -> dict[str, dict]:
+    """Blueprint entity path -> {component: last value}."""
+    reader = RrdReader(str(path))
+    entities: dict[str, dict] = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        for n in batch.schema.names:
+            if ":" not in n:  # components only, not the row ids and times
+                continue
+            values = [v for v in batch.column(n).to_pylist() if v is not None]
+            if values:
+                entities.setdefault(chunk.entity_path, {})[n] = values[-1]
+    return entities
+
+
+def test_follow_opens_on_that_agvs_tab_which_follows_it(corridor, tmp_path):
+    save_rrd(corridor["recording"], tmp_path / "follow.rrd", follow="right")
+    parts = blueprint_entities(tmp_path / "follow.rrd")
+    (active,) = [
+        c["ContainerBlueprint:active_tab"]
+        for c in parts.values()
+        if "ContainerBlueprint:active_tab" in c
+    ]
+    assert parts[f"/{active[0]}"]["ContainerBlueprint:display_name"] == ["right"]
+    origins = {tuple(c.get("ViewBlueprint:space_origin", [""])) for c in parts.values()}
+    assert ("/world/agv/right/pose/follow",) in origins
 
 
 # --- the command line -----------------------------------------------------------------
@@ -270,10 +317,21 @@ def alive(pid: int) -> bool:
         return False
 
 
-def test_replay_web_serves_on_loopback_only_until_ctrl_c_and_ends_its_server(corridor):
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_replay_web_serves_on_loopback_on_its_port_until_stopped_and_ends_its_server(
+    corridor, stop
+):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    port = free_port()
+    command = ["replay", str(corridor["mcap"]), "--web", "--port", str(port)]
     process = subprocess.Popen(
-        [sys.executable, "-m", "fleet.cli", "replay", str(corridor["mcap"]), "--web"],
+        [sys.executable, "-m", "fleet.cli", *command],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -296,12 +354,13 @@ def test_replay_web_serves_on_loopback_only_until_ctrl_c_and_ends_its_server(cor
             seen.append(line)
         url = re.search(r"Rerun web viewer: (\S+)", "".join(seen)).group(1)
         assert urlparse(url).hostname == "127.0.0.1"
+        assert urlparse(url).port == port
         with urllib.request.urlopen(url, timeout=10) as page:
             assert page.status == 200
         children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
         (server,) = map(int, children.split())
         assert listening_hosts(server) == {"0100007F"}  # 127.0.0.1, gRPC and web alike
-        process.send_signal(signal.SIGINT)
+        process.send_signal(stop)  # to our process only, as `timeout` or systemd send it
         assert process.wait(timeout=30) == 0
         deadline = time.monotonic() + 10
         while alive(server) and time.monotonic() < deadline:
