@@ -7,7 +7,7 @@ import json
 from recordings.reader import Recording
 
 # ``run`` metadata with lines of their own; the rest (parameters) is listed as it is
-_SHOWN_RUN_FACTS = ("run_id", "scenario", "version", "started_utc")
+_SHOWN_RUN_FACTS = ("run_id", "scenario", "version", "started_utc", "log_time_zero_ns")
 
 
 def describe_json(rec: Recording) -> dict:

@@ -41,6 +41,7 @@ from bridge import keys
 from bridge.messages import MessageError
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
+from recordings.palette import agv_color
 
 TIMELINE = "sim_time"
 WORLD = "world"
@@ -52,19 +53,6 @@ VELOCITY = "velocity"
 QUANTITIES = ("vx", "vy", "speed", "omega")
 DONE = ("arrived", "failed")
 
-# tab10: distinct colours for up to ten AGVs, then they repeat
-PALETTE = (
-    (31, 119, 180),
-    (255, 127, 14),
-    (44, 160, 44),
-    (214, 39, 40),
-    (148, 103, 189),
-    (140, 86, 75),
-    (227, 119, 194),
-    (127, 127, 127),
-    (188, 189, 34),
-    (23, 190, 207),
-)
 WHITE, GREY, ORANGE, DARK = (230, 230, 230), (160, 160, 160), (255, 160, 0), (20, 20, 20)
 FREE_SHADE, BLOCKED_SHADE = 225, 70  # grey levels of the map image
 LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN"}
@@ -181,7 +169,7 @@ class RowMaker:
         """The first message of an AGV: its colour, label and drawing order, once."""
         if name in self.agv_names:
             return
-        color = PALETTE[len(self.agv_names) % len(PALETTE)]
+        color = agv_color(len(self.agv_names))
         faded = (*color, 140)
         self.agv_names.append(name)
         thick, thin = rr.Radius.ui_points(2.0), rr.Radius.ui_points(1.0)
