@@ -50,7 +50,8 @@ def blueprint(
     shown = [n for n in agv_names[:MAX_AGV_TABS] if n != follow]
     if follow is not None:
         shown.insert(0, follow)
-    tabs = [_fleet_tab(agv_names, map_bounds, end_time), *(_agv_tab(n, end_time) for n in shown)]
+    tabs = [_fleet_tab(agv_names, map_bounds, end_time)]
+    tabs += [_agv_tab(n, agv_names, end_time) for n in shown]
     return rrb.Blueprint(
         rrb.Tabs(*tabs, active_tab=1 if follow is not None else 0),
         _time_panel(end_time, rate),
@@ -96,14 +97,14 @@ def _fleet_tab(agv_names: list[str], map_bounds: Bounds | None, end_time: float 
     )
 
 
-def _agv_tab(name: str, end_time: float | None):
+def _agv_tab(name: str, agv_names: list[str], end_time: float | None):
     w, h = FOLLOW_HALF_SIZE
     follow = rrb.Spatial2DView(
         name=f"following {name}",
         origin=f"/{agv_path(name, 'pose/follow')}",
         contents=f"+ /{WORLD}/**",
         visual_bounds=rrb.VisualBounds2D(x_range=[-w, w], y_range=[-h, h]),
-        overrides={f"/{agv_path(name, 'trail')}": _HISTORY},
+        overrides={f"/{agv_path(n, 'trail')}": _HISTORY for n in agv_names},
     )
     plots = [
         rrb.TimeSeriesView(
