@@ -206,6 +206,21 @@ def blueprint_entities(path: Path) -> dict[str, dict]:
     return entities
 
 
+def test_the_map_view_fits_the_map_and_plots_show_the_whole_run(corridor, tmp_path):
+    save_rrd(corridor["recording"], tmp_path / "fit.rrd")
+    parts = blueprint_entities(tmp_path / "fit.rrd").values()
+    (map_data,) = [m.data for m in corridor["recording"].of("world/map")]
+    w, h = map_data["width"] * map_data["resolution"], map_data["height"] * map_data["resolution"]
+    bounds = [c["VisualBounds2D:range"][0] for c in parts if "VisualBounds2D:range" in c]
+    fitted = [b for b in bounds if b["x_range"][0] <= 0 < w <= b["x_range"][1]]
+    (fit,) = fitted  # the fleet map (the AGV tabs' views are smaller, around the AGV)
+    assert fit["y_range"][0] <= -h and fit["y_range"][1] >= 0  # y flipped by `world`
+    assert fit["x_range"][1] - fit["x_range"][0] < 1.2 * w  # and not much more
+    end_ns = round(corridor["recording"].of("world/tick")[-1].data["time"] * 1e9)
+    ranges = [c["TimeAxis:view_range"][0] for c in parts if "TimeAxis:view_range" in c]
+    assert ranges and all(r["start"] == 0 and r["end"] >= end_ns for r in ranges)
+
+
 def test_follow_opens_on_that_agvs_tab_which_follows_it(corridor, tmp_path):
     save_rrd(corridor["recording"], tmp_path / "follow.rrd", follow="right")
     parts = blueprint_entities(tmp_path / "follow.rrd")
