@@ -44,7 +44,8 @@ def add_parsers(sub) -> None:
         "--rate",
         type=positive_float,
         metavar="F",
-        help="play at F x real time into the viewer or web viewer (default: all at once)",
+        help="open the viewer or web viewer playing at F x real time (default: paused at the "
+        "start of the run)",
     )
     p.set_defaults(handler=replay)
 
@@ -53,7 +54,7 @@ def replay(args: argparse.Namespace) -> int:
     viewer = not (args.save or args.web)
     try:
         if args.rate and not (viewer or args.web):
-            raise RerunError("--rate paces the viewer or --web, not --save")
+            raise RerunError("--rate plays the viewer or --web, not --save")
         if args.port and not args.web:
             raise RerunError("--port is the web viewer's: add --web")
         if not 0 <= args.port <= 65535:

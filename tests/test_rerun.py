@@ -285,7 +285,10 @@ def test_replay_when_the_viewer_cannot_open_a_window_exits_2_with_one_line(corri
         (["{tmp}/missing.mcap", "--save", "{tmp}/x.rrd"], "no such file"),
         (["{tmp}/notes.mcap", "--save", "{tmp}/x.rrd"], "not an MCAP recording"),
         (["{mcap}", "--save", "{tmp}/no/such/folder/x.rrd"], "No such file or directory"),
-        (["{mcap}", "--save", "{tmp}/x.rrd", "--rate", "2"], "--rate paces the viewer or --web"),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--rate", "2"], "--rate plays the viewer or --web"),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--port", "9876"], "--port is the web viewer's"),
+        (["{mcap}", "--web", "--port", "70000"], "--port 70000: not a TCP port"),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--follow", "nobody"], "no such AGV"),
     ],
 )
 def test_replay_errors_exit_2_with_one_line(corridor, tmp_path, args, message):
