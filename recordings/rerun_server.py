@@ -97,8 +97,10 @@ class WebServer:
 
     def __enter__(self) -> WebServer:
         options = ["--serve-web", "--web-viewer-port", str(self.port)]
+        # its own session: a Ctrl-C in the terminal reaches us alone, and we end the
+        # server after the last flush (ended first, it made the SDK log gRPC errors)
         self._process, (grpc, web) = _start(
-            "the Rerun web server", options, (_GRPC, _WEB), detach=False
+            "the Rerun web server", options, (_GRPC, _WEB), detach=True
         )
         self.grpc_url = _grpc_url(grpc)
         self.web_url = f"http://127.0.0.1:{web}/?url={quote(self.grpc_url, safe='')}"

@@ -84,7 +84,8 @@ class Outputs:
         try:
             self.stream.flush(timeout_sec=FLUSH_TIMEOUT)
         except RuntimeError as err:
-            # A Ctrl-C in the terminal ends the web server too: nobody is left to deliver to.
+            # The web server ended on its own (it has its own session, so a Ctrl-C does
+            # not reach it): nobody is left to deliver to.
             if self._server is None or self._server.running:
                 raise RerunError(f"Rerun did not get everything: {err}") from None
         finally:

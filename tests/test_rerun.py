@@ -341,7 +341,15 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def ctrl_c_in_the_terminal(process):
+    os.killpg(process.pid, signal.SIGINT)  # the whole foreground process group
+
+
+def sigterm(process):
+    process.send_signal(signal.SIGTERM)  # our process only, as `timeout` or systemd send it
+
+
+@pytest.mark.parametrize("stop", [ctrl_c_in_the_terminal, sigterm])
 def test_replay_web_serves_on_loopback_on_its_port_until_stopped_and_ends_its_server(
     corridor, stop
 ):
@@ -354,6 +362,7 @@ def test_replay_web_serves_on_loopback_on_its_port_until_stopped_and_ends_its_se
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        start_new_session=True,  # a process group of its own, as a terminal makes
     )
     lines: queue.Queue[str | None] = queue.Queue()
 
@@ -378,8 +387,12 @@ def test_replay_web_serves_on_loopback_on_its_port_until_stopped_and_ends_its_se
         children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
         (server,) = map(int, children.split())
         assert listening_hosts(server) == {"0100007F"}  # 127.0.0.1, gRPC and web alike
-        process.send_signal(stop)  # to our process only, as `timeout` or systemd send it
+        stop(process)
         assert process.wait(timeout=30) == 0
+        said = []
+        while (line := lines.get(timeout=10)) is not None:
+            said.append(line)
+        assert not [line for line in said if "ERROR" in line], said  # a quiet ending
         deadline = time.monotonic() + 10
         while alive(server) and time.monotonic() < deadline:
             time.sleep(0.05)
