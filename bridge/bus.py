@@ -13,13 +13,13 @@ from __future__ import annotations
 
 import json
 import queue
-import sys
 from collections import Counter
 from dataclasses import dataclass
 
 import zenoh
 
 from bridge import keys
+from bridge.log import say
 from bridge.messages import MessageError, from_dict, to_dict
 from bridge.session import MAX_MESSAGE_BYTES
 
@@ -113,7 +113,7 @@ class Bus:
         self.invalid[key] += 1
         if self.invalid[key] == 1:
             shown = key if len(key) <= 100 else key[:100] + "..."
-            print(f"agv-fleet: ignoring invalid message on {shown}: {why}", file=sys.stderr)
+            say(f"agv-fleet: ignoring invalid message on {shown}: {why}")
 
     # --- liveliness -------------------------------------------------------------------
     def declare_alive(self, key: str) -> zenoh.LivelinessToken:

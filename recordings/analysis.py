@@ -66,8 +66,10 @@ class AgvAnalysis:
 class RunAnalysis:
     path: str
     scenario: str
+    algorithm: str  # the run's --algorithm, else the global planner(s) its plans name
     run_id: str
     finished: bool  # the recording has the run's result
+    end_reason: str | None  # as the run reported it ("time limit", ...); None: not finished
     truncated: bool
     dt: float | None
     ticks: int
@@ -89,8 +91,22 @@ class RunAnalysis:
     plan_time_p95_ms: float | None
     agvs: tuple[AgvAnalysis, ...]
 
+    @property
+    def label(self) -> str:
+        """What tells runs apart in comparisons and plot titles: scenario and algorithm."""
+        name = self.scenario or self.path
+        return f"{name} ({self.algorithm})" if self.algorithm else name
+
     def to_json(self) -> dict:
         return json_ready(asdict(self))
+
+
+def _algorithm(run: dict, series: RunSeries) -> str:
+    given = run.get("algorithm")
+    if given and given != "scenario's":
+        return str(given)
+    planners = {p.get("algorithm") for plans in series.plans.values() for p in plans}
+    return "+".join(sorted(str(a) for a in planners if a))
 
 
 def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
@@ -113,8 +129,10 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
     return RunAnalysis(
         path=str(rec.path),
         scenario=str(run.get("scenario", result.get("scenario", ""))),
+        algorithm=_algorithm(run, series),
         run_id=str(run.get("run_id", "")),
         finished=rec.result is not None,
+        end_reason=None if rec.result is None else str(result.get("end_reason", "")),
         truncated=rec.truncated,
         dt=dt,
         ticks=int(series.tick[-1]) if len(series.tick) else 0,

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import json
+import textwrap
 
 from recordings.reader import Recording
 
+WIDTH = 100  # columns: long values wrap under their label
+LABEL_WIDTH = 12
+
 # ``run`` metadata with lines of their own; the rest (parameters) is listed as it is
-_SHOWN_RUN_FACTS = ("run_id", "scenario", "version", "started_utc")
+_SHOWN_RUN_FACTS = ("run_id", "scenario", "version", "started_utc", "log_time_zero_ns")
 
 
 def describe_json(rec: Recording) -> dict:
@@ -54,7 +58,7 @@ def describe(rec: Recording) -> str:
     ]
     if info["recovered"]:
         lines.append(("Recovered", info["recovered"]))
-    out = [f"{label + ':':<12}{value}" for label, value in lines]
+    out = [_wrapped(label, value) for label, value in lines]
     width = max((len(c["topic"]) for c in info["channels"]), default=0)
     count_width = max((len(str(c["messages"])) for c in info["channels"]), default=0)
     for i, c in enumerate(info["channels"]):
@@ -66,11 +70,26 @@ def describe(rec: Recording) -> str:
     return "\n".join(out)
 
 
+def _wrapped(label: str, value: str) -> str:
+    return textwrap.fill(
+        value,
+        width=WIDTH,
+        initial_indent=f"{label + ':':<{LABEL_WIDTH}}",
+        subsequent_indent=" " * LABEL_WIDTH,
+        break_on_hyphens=False,
+    )
+
+
 def _ending(rec: Recording) -> str:
     result = rec.result
     if result is None:
         why = "recording truncated" if rec.truncated else "no result recorded"
         return f"did not finish ({why})"
+    if "found" in result:  # a plan-only recording (agv-fleet paper): plans, no simulation
+        found = ", ".join(
+            f"{a} {'found' if ok else 'no path'}" for a, ok in result["found"].items()
+        )
+        return f"plans only, no simulation: {found}"
     agvs = result.get("agvs", [])
     success = result.get("collisions", 0) == 0 and all(a.get("status") == "arrived" for a in agvs)
     return (
@@ -82,7 +101,7 @@ def _ending(rec: Recording) -> str:
 def _agvs(rec: Recording) -> str:
     """AGV names, with how each ended when the run finished."""
     result = rec.result
-    if result is None:
+    if result is None or "agvs" not in result:
         return ", ".join(rec.agv_names()) or "none"
     parts = []
     for a in result.get("agvs", []):

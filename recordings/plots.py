@@ -18,12 +18,13 @@ DPI = 100
 LEGEND_MAX = 12  # more AGVs than this: no legend, it would cover the map
 
 
-def save_plots(series: RunSeries, out_dir: Path, stem: str) -> list[Path]:
-    """Write ``<stem>-map.png`` and ``<stem>-velocity-<agv>.png`` into ``out_dir``."""
+def save_plots(series: RunSeries, out_dir: Path, stem: str, label: str) -> list[Path]:
+    """Write ``<stem>-map.png`` and ``<stem>-velocity-<agv>.png`` into ``out_dir``,
+    titled with ``label`` (scenario and algorithm: which run it is)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [_save(_map_figure(series), out_dir / f"{stem}-map.png")]
+    paths = [_save(_map_figure(series, label), out_dir / f"{stem}-map.png")]
     for i, name in enumerate(series.agvs.names):
-        figure = _velocity_figure(series, i)
+        figure = _velocity_figure(series, i, label)
         paths.append(_save(figure, out_dir / f"{stem}-velocity-{name}.png"))
     return paths
 
@@ -34,7 +35,7 @@ def _save(figure: Figure, path: Path) -> Path:
     return path
 
 
-def _map_figure(series: RunSeries) -> Figure:
+def _map_figure(series: RunSeries, label: str) -> Figure:
     grid = series.grid
     width, height = grid.size_m if grid else (10.0, 10.0)
     x0, x1, y0, y1 = grid.extent if grid else (0.0, width, 0.0, height)
@@ -69,7 +70,7 @@ def _map_figure(series: RunSeries) -> Figure:
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title("trajectories (solid), first global path (dotted), key nodes (o)")
+    ax.set_title(f"{label}\ntrajectories (solid), first global path (dotted), key nodes (o)")
     if 0 < len(series.agvs.names) <= LEGEND_MAX:
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     figure.tight_layout()
@@ -86,7 +87,7 @@ def _temporary_cells(ax, series: RunSeries) -> None:
         ax.add_patch(Rectangle(square, res, res, color="tab:orange", alpha=0.8))
 
 
-def _velocity_figure(series: RunSeries, i: int) -> Figure:
+def _velocity_figure(series: RunSeries, i: int, label: str) -> Figure:
     c = {f: v[:, i] for f, v in series.agvs.columns.items()}
     t = series.time
     figure = Figure(figsize=(7.0, 4.5))
@@ -98,7 +99,7 @@ def _velocity_figure(series: RunSeries, i: int) -> Figure:
     speed_ax.set_ylabel("v (m/s)")
     omega_ax.set_ylabel("ω (rad/s)")
     omega_ax.set_xlabel("sim time (s)")
-    speed_ax.set_title(f"{series.agvs.names[i]}: linear and angular velocity")
+    speed_ax.set_title(f"{label}, {series.agvs.names[i]}: linear and angular velocity")
     for ax in (speed_ax, omega_ax):
         ax.grid(True, lw=0.4, alpha=0.6)
     figure.tight_layout()

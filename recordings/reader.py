@@ -194,6 +194,12 @@ class Recording:
         return _metadata_values(self.metadata.get("run", {}))
 
     @property
+    def log_time_zero_ns(self) -> int:
+        """The log time of sim time 0 (the run's wall-clock start; 0 in recordings
+        made before log times were wall-clock times)."""
+        return int(self.run.get("log_time_zero_ns", 0))
+
+    @property
     def result(self) -> dict | None:
         """How the run ended (the ``result`` metadata, decoded), None if it did not finish."""
         record = self.metadata.get("result")

@@ -8,74 +8,88 @@ from dataclasses import asdict, fields
 
 from recordings.analysis import AgvAnalysis, RunAnalysis, compare, json_ready
 
-# per-AGV table: (header, AgvAnalysis field, format)
+TABLE_WIDTH = 100  # columns the default tables fit in (--wide: every column)
+
+# per-AGV table: (header, unit, AgvAnalysis field, format, in the default table)
 AGV_COLUMNS = (
-    ("AGV", "name", "{}"),
-    ("status", "status", "{}"),
-    ("arrival s", "arrival_time", "{:.1f}"),
-    ("dist m", "distance", "{:.2f}"),
-    ("path m", "path_length", "{:.2f}"),
-    ("turns", "turns", "{}"),
-    ("turn °", "turning_angle_deg", "{:.1f}"),
-    ("replans", "replans", "{}"),
-    ("a rms m/s²", "rms_accel", "{:.3f}"),
-    ("jerk rms m/s³", "rms_jerk", "{:.3f}"),
-    ("|Δω| rad/s", "mean_abs_domega", "{:.4f}"),
-    ("ω sign ch.", "omega_sign_changes", "{}"),
-    ("clear obst m", "min_clearance_obstacles", "{:.2f}"),
-    ("clear AGV m", "min_clearance_agvs", "{:.2f}"),
-    ("coll.", "collisions", "{}"),
-    ("plan ms", "plan_time_mean_ms", "{:.2f}"),
-    ("plan p95 ms", "plan_time_p95_ms", "{:.2f}"),
+    ("AGV", "", "name", "{}", True),
+    ("status", "", "status", "{}", True),
+    ("arrival", "s", "arrival_time", "{:.1f}", True),
+    ("travelled", "m", "distance", "{:.2f}", True),
+    ("path", "m", "path_length", "{:.2f}", True),
+    ("turns", "", "turns", "{}", False),
+    ("turning", "deg", "turning_angle_deg", "{:.1f}", False),
+    ("replans", "", "replans", "{}", True),
+    ("accel RMS", "m/s²", "rms_accel", "{:.3f}", True),
+    ("jerk RMS", "m/s³", "rms_jerk", "{:.3f}", True),
+    ("mean |Δω|", "rad/s", "mean_abs_domega", "{:.4f}", False),
+    ("ω sign", "changes", "omega_sign_changes", "{}", False),
+    ("obstacle", "gap m", "min_clearance_obstacles", "{:.2f}", True),
+    ("AGV", "gap m", "min_clearance_agvs", "{:.2f}", True),
+    ("collisions", "", "collisions", "{}", True),
+    ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
+    ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
 )
+HIDDEN_NOTE = "(--wide adds turns, turning angle, |Δω|, ω sign changes and planning times)"
 
 
 def _cell(value, fmt: str) -> str:
     return "-" if value is None else fmt.format(value)
 
 
-def _table(rows: list[list[str]], right_from: int = 1) -> str:
-    """Columns padded to width; numbers (from column ``right_from``) right-aligned."""
-    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
-    lines = []
-    for n, row in enumerate(rows):
+def _table(header: list[list[str]], rows: list[list[str]], right_from: int = 1) -> str:
+    """Columns padded to width under a header of one or more lines; numbers (from
+    column ``right_from``) right-aligned."""
+    every = [*header, *rows]
+    widths = [max(len(r[i]) for r in every) for i in range(len(every[0]))]
+
+    def line(row):
         cells = [
             c.ljust(w) if i < right_from else c.rjust(w)
             for i, (c, w) in enumerate(zip(row, widths, strict=True))
         ]
-        lines.append("  ".join(cells).rstrip())
-        if n == 0:
-            lines.append("  ".join("-" * w for w in widths))
-    return "\n".join(lines)
+        return "  ".join(cells).rstrip()
+
+    rule = "  ".join("-" * w for w in widths)
+    return "\n".join([*(line(h) for h in header), rule, *(line(r) for r in rows)])
 
 
-def run_table(run: RunAnalysis) -> str:
-    """The per-AGV table of one run and a line for the run."""
-    rows = [[h for h, _, _ in AGV_COLUMNS]]
-    rows += [[_cell(getattr(a, f), fmt) for _, f, fmt in AGV_COLUMNS] for a in run.agvs]
-    state = "finished" if run.finished else "did not finish"
+def _state(run: RunAnalysis) -> str:
+    """How the run ended, in the words ``agv-fleet run`` used ("time limit", ...)."""
+    state = run.end_reason or "ended" if run.finished else "did not finish"
     if run.truncated:
         state += ", recording truncated"
+    return state
+
+
+def run_table(run: RunAnalysis, wide: bool = False) -> str:
+    """The per-AGV table of one run and a line for the run (``wide``: every column)."""
+    columns = [c for c in AGV_COLUMNS if wide or c[4]]
+    header = [[c[0] for c in columns], [c[1] for c in columns]]
+    rows = [[_cell(getattr(a, c[2]), c[3]) for c in columns] for a in run.agvs]
     line = (
-        f"{run.scenario or run.path}: {run.arrived}/{len(run.agvs)} arrived, "
+        f"{run.label}: {run.arrived}/{len(run.agvs)} arrived, "
         f"{run.collisions} collisions, run time {run.run_time:.1f} s, {run.ticks} ticks "
-        f"({state})"
+        f"({_state(run)})"
     )
-    return (_table(rows, right_from=2) if run.agvs else "(no AGVs)") + "\n" + line
+    table = _table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
+    note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
+    return f"{table}\n{line}{note}"
 
 
 def comparison_table(runs: list[RunAnalysis]) -> str:
-    """Run-level metrics side by side, with the % difference to the first run."""
+    """Run-level metrics side by side, with the % difference to the first run; each
+    run numbered and named by scenario, algorithm and file below."""
     header = ["metric", *(f"[{i + 1}]" for i in range(len(runs)))]
     header += [f"[{i + 1}] vs [1]" for i in range(1, len(runs))]
-    rows = [header]
+    rows = []
     for m in compare(runs):
         name = f"{m.label} ({m.unit})" if m.unit else m.label
         values = [_cell(v, "{:.4g}") for v in m.values]
         changes = [_cell(c, "{:+.1f} %") for c in m.change_pct[1:]]
         rows.append([name, *values, *changes])
-    legend = "\n".join(f"[{i + 1}] {r.path}" for i, r in enumerate(runs))
-    return _table(rows) + "\n" + legend
+    legend = "\n".join(f"[{i + 1}] {r.label}: {r.path}" for i, r in enumerate(runs))
+    return _table([header], rows) + "\n" + legend
 
 
 def to_json(runs: list[RunAnalysis]) -> dict:
@@ -90,16 +104,33 @@ def to_json(runs: list[RunAnalysis]) -> dict:
     return out
 
 
+CSV_RUN_FIELDS = ("path", "scenario", "algorithm", "run_id", "finished", "end_reason", "truncated")
+
+
+def _csv_value(value):
+    """Plain values: yes/no for booleans, empty for none."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    return value
+
+
 def to_csv(runs: list[RunAnalysis]) -> str:
-    """One row per AGV per recording, with the recording's run-level facts in front."""
-    run_fields = ("path", "scenario", "run_id", "finished", "truncated", "run_time")
+    """One ``run`` row per recording (its run-level metrics) followed by one ``agv``
+    row per AGV; the recording's facts in front of every row. A metric that does not
+    apply to a row's kind is empty; booleans are yes/no."""
     agv_fields = [f.name for f in fields(AgvAnalysis)]
+    run_metrics = {f.name for f in fields(RunAnalysis)} - {"agvs", *CSV_RUN_FIELDS}
+    metrics = [*agv_fields, *sorted(run_metrics - set(agv_fields))]
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow([*run_fields, *agv_fields])
+    writer.writerow(["row", *CSV_RUN_FIELDS, *metrics])
     for run in runs:
-        facts = [getattr(run, f) for f in run_fields]
+        facts = [_csv_value(getattr(run, f)) for f in CSV_RUN_FIELDS]
+        values = asdict(run)
+        writer.writerow(["run", *facts, *(_csv_value(values.get(f)) for f in metrics)])
         for agv in run.agvs:
             values = asdict(agv)
-            writer.writerow([*facts, *("" if values[f] is None else values[f] for f in agv_fields)])
+            writer.writerow(["agv", *facts, *(_csv_value(values.get(f)) for f in metrics)])
     return buffer.getvalue()

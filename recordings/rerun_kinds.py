@@ -67,3 +67,9 @@ def scalar(payloads):
 def text(payloads):
     """payload: (text, level), level a name of rr.TextLogLevel (INFO, WARN, ERROR)."""
     return rr.TextLog.columns(text=[p[0] for p in payloads], level=[p[1] for p in payloads])
+
+
+def translation(payloads):
+    """payload: [x, y]: where a frame's origin is (a followed AGV's frame)."""
+    xy = _xy(payloads)
+    return rr.Transform3D.columns(translation=np.column_stack([xy, np.zeros(len(xy))]))

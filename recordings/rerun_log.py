@@ -62,14 +62,17 @@ def _nanoseconds(seconds: list[float]) -> np.ndarray:
     return np.round(np.asarray(seconds) * 1e9).astype(np.int64).astype("timedelta64[ns]")
 
 
-def send_recording(stream: rr.RecordingStream, messages) -> None:
-    """Convert a whole recording and send it, with its blueprint."""
+def send_recording(stream: rr.RecordingStream, messages, follow=None, rate=None) -> None:
+    """Convert a whole recording and send it, with its blueprint (options: see
+    ``rerun_blueprint.blueprint``)."""
     maker = RowMaker(recording_dt(messages))
     columns = Columns(stream)
     for m in messages:
         columns.add(maker.feed(m.topic, m.data))
     columns.send()
-    stream.send_blueprint(blueprint(maker.agv_names))
+    stream.send_blueprint(
+        blueprint(maker.agv_names, maker.map_bounds, maker.end_time, follow=follow, rate=rate)
+    )
 
 
 class Live:
@@ -88,7 +91,7 @@ class Live:
         names = self._maker.agv_names
         if len(names) != self._agvs_shown:
             self._agvs_shown = len(names)
-            self._stream.send_blueprint(blueprint(names))
+            self._stream.send_blueprint(blueprint(names, self._maker.map_bounds))
         if time.monotonic() >= self._due:
             self.send()
 

@@ -8,32 +8,41 @@ rows, so they show the same entities.
 Entity paths (everything on the map under ``world``, in world coordinates):
 
     world                         Transform3D, static: shows y up (see ``world_rows``)
-    world/map                     Boxes2D, static: blocked cells (merged) and the border
+    world/map                     Image + Transform3D, static: the grid, one pixel a cell
     world/temporary               Boxes2D: temporary obstacles shown so far
     world/moving                  Points2D discs with labels: moving obstacles
-    world/agv/<name>/body         Points2D disc (radius = AGV radius), labelled
-    world/agv/<name>/heading      Arrows2D: heading
+    world/agv/<name>/body         Points2D disc (radius = AGV radius)
+    world/agv/<name>/heading      Arrows2D: heading, centre to beyond the rim
+    world/agv/<name>/label        Points2D: the name, beside the disc (not over it)
+    world/agv/<name>/start        Boxes2D, static: where the AGV started
+    world/agv/<name>/goal         LineStrips2D, static: a cross on its goal (end of its path)
+    world/agv/<name>/pose         Transform3D: the AGV's position (a frame to follow it in)
+    world/agv/<name>/pose/follow  Transform3D, static: y up again inside that frame
     world/agv/<name>/trail        LineStrips2D: one segment per tick (the view shows all history)
     world/agv/<name>/plan         LineStrips2D: global path (a replan replaces it)
     world/agv/<name>/plan/key_nodes  Points2D: key nodes
     world/agv/<name>/dwa          LineStrips2D: DWA's chosen trajectory (cleared on arrival)
-    events                        TextLog: collisions, arrivals, failures, the end
-    velocity/<q>/<name>           Scalars, q in vx, vy, speed (|v|), omega
+    events/<kind>                 TextLog: one entity per kind of event (the world's events:
+                                  arrived, failed, collision, end, ...; and from the plans:
+                                  replan, no path)
+    velocity/<q>/<name>           Scalars, q in vx, vy (body frame), speed (|v|), omega
 """
 
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Callable, Iterable
 from typing import Any, NamedTuple
 
+import numpy as np
 import rerun as rr
 
 from bridge import keys
 from bridge.messages import MessageError
 from planner.agv_status import FINISHED
 from recordings import rerun_kinds as kinds
+from recordings.map_frame import map_origin, map_size
+from recordings.palette import agv_color
 
 TIMELINE = "sim_time"
 WORLD = "world"
@@ -44,21 +53,11 @@ EVENTS = "events"
 VELOCITY = "velocity"
 QUANTITIES = ("vx", "vy", "speed", "omega")
 
-# tab10: distinct colours for up to ten AGVs, then they repeat
-PALETTE = (
-    (31, 119, 180),
-    (255, 127, 14),
-    (44, 160, 44),
-    (214, 39, 40),
-    (148, 103, 189),
-    (140, 86, 75),
-    (227, 119, 194),
-    (127, 127, 127),
-    (188, 189, 34),
-    (23, 190, 207),
-)
-WHITE, GREY, ORANGE = (230, 230, 230), (160, 160, 160), (255, 160, 0)
-LEVELS = {"collision": "WARN", "failed": "ERROR"}
+WHITE, GREY, ORANGE, DARK = (230, 230, 230), (160, 160, 160), (255, 160, 0), (20, 20, 20)
+FREE_SHADE, BLOCKED_SHADE = 225, 70  # grey levels of the map image
+LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN"}
+HEADING_LENGTH = 2.0  # x radius: the heading line sticks out of the disc, visible when small
+LABEL_GAP = 1.0  # m right of the disc's rim: the name (centred on its anchor) never covers it
 
 
 class Row(NamedTuple):
@@ -70,6 +69,10 @@ class Row(NamedTuple):
 
 def agv_path(name: str, part: str) -> str:
     return f"{WORLD}/agv/{rr.escape_entity_path_part(name)}/{part}"
+
+
+def event_path(kind: str) -> str:
+    return f"{EVENTS}/{rr.escape_entity_path_part(kind)}"
 
 
 def velocity_path(quantity: str, name: str) -> str:
@@ -105,7 +108,11 @@ class RowMaker:
     def __init__(self, dt: float):
         self.dt = dt
         self.agv_names: list[str] = []
+        self.map_bounds: tuple[float, float, float, float] | None = None  # x0, y0, x1, y1 (m)
+        self.end_time = 0.0  # sim time of the last tick seen
         self._resolution = 1.0
+        self._origin = (0.0, 0.0)
+        self._goal_shown: set[str] = set()
         self._last_xy: dict[str, tuple[float, float]] = {}
         self._dwa_shown: set[str] = set()
         self._moving_shown = False
@@ -145,34 +152,43 @@ class RowMaker:
 
     # --- static ------------------------------------------------------------------
     def _map(self, data: dict, rows: list[Row]) -> None:
+        """The grid as one image, a pixel per cell (filled obstacles, and one image
+        whatever the map's size), placed on the world by its transform."""
         res = self._resolution = data["resolution"]
-        rects = blocked_rectangles(data["rows"])
-        centers = [[(c0 + c1) * res / 2, (r0 + r1) * res / 2] for c0, r0, c1, r1 in rects]
-        half = [[(c1 - c0) * res / 2, (r1 - r0) * res / 2] for c0, r0, c1, r1 in rects]
-        w, h = data["width"] * res, data["height"] * res
-        colors = [(90, 90, 90)] * len(rects) + [(200, 200, 200)]
-        boxes = rr.Boxes2D(
-            centers=[*centers, [w / 2, h / 2]],
-            half_sizes=[*half, [w / 2, h / 2]],
-            colors=colors,
-            radii=rr.Radius.ui_points(1.0),
-            draw_order=0.0,
-        )
-        rows.append(Row(MAP, None, None, [boxes]))
+        x0, y0 = self._origin = map_origin(data)
+        w, h = map_size(data)
+        self.map_bounds = (x0, y0, x0 + w, y0 + h)
+        cells = np.frombuffer("".join(data["rows"]).encode(), dtype=np.uint8)
+        blocked = cells.reshape(data["height"], data["width"]) == ord("#")
+        shades = np.where(blocked, BLOCKED_SHADE, FREE_SHADE).astype(np.uint8)
+        # image row 0 (the top row) at the map's top edge, rows going down
+        place = rr.Transform3D(translation=[x0, y0 + h, 0.0], scale=[res, -res, 1.0])
+        image = rr.Image(shades, color_model="L", draw_order=0.0)
+        rows.append(Row(MAP, None, None, [place, image]))
 
     def _meet(self, name: str, rows: list[Row]) -> None:
         """The first message of an AGV: its colour, label and drawing order, once."""
         if name in self.agv_names:
             return
-        color = PALETTE[len(self.agv_names) % len(PALETTE)]
+        color = agv_color(len(self.agv_names))
         faded = (*color, 140)
         self.agv_names.append(name)
         thick, thin = rr.Radius.ui_points(2.0), rr.Radius.ui_points(1.0)
         styles = {
-            "body": rr.Points2D.from_fields(
-                colors=color, labels=name, show_labels=True, draw_order=30.0
+            "body": rr.Points2D.from_fields(colors=color, draw_order=30.0),
+            "heading": rr.Arrows2D.from_fields(
+                colors=DARK, radii=rr.Radius.ui_points(1.5), draw_order=31.0
             ),
-            "heading": rr.Arrows2D.from_fields(colors=WHITE, radii=thin, draw_order=31.0),
+            "label": rr.Points2D.from_fields(
+                colors=color,
+                radii=rr.Radius.ui_points(0.5),
+                labels=name,
+                show_labels=True,
+                draw_order=32.0,
+            ),
+            "start": rr.Boxes2D.from_fields(colors=color, radii=thick, draw_order=12.0),
+            "goal": rr.LineStrips2D.from_fields(colors=color, radii=thick, draw_order=12.0),
+            "pose/follow": rr.Transform3D(scale=[1.0, -1.0, 1.0]),
             "trail": rr.LineStrips2D.from_fields(colors=faded, radii=thick, draw_order=15.0),
             "plan": rr.LineStrips2D.from_fields(colors=color, radii=thin, draw_order=20.0),
             "plan/key_nodes": rr.Points2D.from_fields(
@@ -188,15 +204,21 @@ class RowMaker:
 
     # --- temporal ----------------------------------------------------------------
     def _tick(self, data: dict, rows: list[Row]) -> None:
-        t = data["time"]
+        t = self.end_time = data["time"]
         for s in data["agvs"]:
             name = s["name"]
             self._meet(name, rows)
             x, y, r = s["x"], s["y"], s["radius"]
-            rows.append(Row(agv_path(name, "body"), kinds.points, t, ([[x, y]], [r], None)))
-            arrow = [1.5 * r * math.cos(s["theta"]), 1.5 * r * math.sin(s["theta"])]
-            rows.append(Row(agv_path(name, "heading"), kinds.arrow, t, ([x, y], arrow)))
             last = self._last_xy.get(name)
+            if last is None:
+                rows.append(_start(name, x, y, r))
+            rows.append(Row(agv_path(name, "body"), kinds.points, t, ([[x, y]], [r], None)))
+            length = HEADING_LENGTH * r
+            arrow = [length * math.cos(s["theta"]), length * math.sin(s["theta"])]
+            rows.append(Row(agv_path(name, "heading"), kinds.arrow, t, ([x, y], arrow)))
+            beside = [[x + r + LABEL_GAP, y]]
+            rows.append(Row(agv_path(name, "label"), kinds.points, t, (beside, None, None)))
+            rows.append(Row(agv_path(name, "pose"), kinds.translation, t, [x, y]))
             if last is not None and last != (x, y):
                 rows.append(Row(agv_path(name, "trail"), kinds.strips, t, [[list(last), [x, y]]]))
             self._last_xy[name] = (x, y)
@@ -211,8 +233,8 @@ class RowMaker:
             self._moving_shown = bool(moving)
         if data["temporary"] != self._temporary:
             self._temporary = data["temporary"]
-            res = self._resolution
-            centers = [[(c + 0.5) * res, (r + 0.5) * res] for c, r in self._temporary]
+            res, (x0, y0) = self._resolution, self._origin
+            centers = [[x0 + (c + 0.5) * res, y0 + (r + 0.5) * res] for c, r in self._temporary]
             half = [[res / 2, res / 2]] * len(centers)
             rows.append(Row(TEMPORARY, kinds.boxes, t, (centers, half)))
 
@@ -231,6 +253,16 @@ class RowMaker:
         key_nodes = data["key_nodes"] if data["found"] else []
         rows.append(Row(agv_path(name, "plan"), kinds.strips, t, [path] if path else []))
         rows.append(Row(agv_path(name, "plan/key_nodes"), kinds.points, t, (key_nodes, None, None)))
+        if path and name not in self._goal_shown:
+            self._goal_shown.add(name)
+            rows.append(_goal(name, path[-1]))
+        if not data["found"]:
+            self._log_event(t, "no path", [name], data["reason"], rows)
+        elif data["reason"] != "initial":
+            detail = f"new path {data['length']:.1f} m"
+            if data["reason"] != "replan":
+                detail = f"{data['reason']}, {detail}"
+            self._log_event(t, "replan", [name], detail, rows)
 
     def _trajectory(self, name: str, data: dict, rows: list[Row]) -> None:
         self._dwa_shown.add(name)
@@ -238,28 +270,25 @@ class RowMaker:
         rows.append(Row(agv_path(name, "dwa"), kinds.strips, self._time(data["tick"]), [points]))
 
     def _event(self, data: dict, rows: list[Row]) -> None:
-        kind, detail = data["kind"], data["detail"]
-        text = " ".join([kind, *data["agvs"]])  # "arrived agv1", "collision left right"
+        self._log_event(data["time"], data["kind"], data["agvs"], data["detail"], rows)
+
+    def _log_event(self, t: float, kind: str, agvs: list[str], detail: str, rows: list[Row]):
+        """Any kind of event, on an entity of its own: "replan agv7: stuck, ..."."""
+        text = " ".join([kind, *agvs])  # "arrived agv1", "collision left right"
         if detail and detail != kind:
             text += f": {detail}"
-        rows.append(Row(EVENTS, kinds.text, data["time"], (text, LEVELS.get(kind, "INFO"))))
+        rows.append(Row(event_path(kind), kinds.text, t, (text, LEVELS.get(kind, "INFO"))))
 
 
-def blocked_rectangles(rows_top_down: list[str]) -> list[tuple[int, int, int, int]]:
-    """Blocked cells as few rectangles (col0, row0, col1, row1), half-open, row 0 at
-    the bottom: runs of '#' in a row, merged with the same run in the rows above.
-    A 1000x1000 map would otherwise be up to a million boxes."""
-    done: list[tuple[int, int, int, int]] = []
-    open_runs: dict[tuple[int, int], int] = {}  # (col0, col1) -> first row
-    height = len(rows_top_down)
-    for row in range(height + 1):
-        runs = set(_runs(rows_top_down[height - 1 - row])) if row < height else set()
-        for run in [r for r in open_runs if r not in runs]:
-            done.append((run[0], open_runs.pop(run), run[1], row))
-        for run in runs:
-            open_runs.setdefault(run, row)
-    return sorted(done)
+def _start(name: str, x: float, y: float, r: float) -> Row:
+    """A square around the AGV's first position."""
+    square = rr.Boxes2D(centers=[[x, y]], half_sizes=[[r, r]])
+    return Row(agv_path(name, "start"), None, None, [square])
 
 
-def _runs(line: str):
-    return ((m.start(), m.end()) for m in re.finditer("#+", line))
+def _goal(name: str, xy: list[float]) -> Row:
+    """A cross in the AGV's colour on its goal (the end of its first path)."""
+    x, y = xy
+    d = 0.35
+    cross = [[[x - d, y - d], [x + d, y + d]], [[x - d, y + d], [x + d, y - d]]]
+    return Row(agv_path(name, "goal"), None, None, [rr.LineStrips2D(cross)])

@@ -87,18 +87,22 @@ def _stop(process: subprocess.Popen) -> None:
 
 
 class WebServer:
-    """``with WebServer() as server``: ``server.grpc_url`` to log to, ``server.web_url``
-    to open in a browser; the server ends with the block."""
+    """``with WebServer(port) as server``: ``server.grpc_url`` to log to,
+    ``server.web_url`` to open in a browser (on ``port``; 0: a free port); the
+    server ends with the block."""
 
-    def __init__(self):
+    def __init__(self, port: int = 0):
+        self.port = port
         self.grpc_url = ""
         self.web_url = ""
         self._process: subprocess.Popen | None = None
 
     def __enter__(self) -> WebServer:
-        options = ["--serve-web", "--web-viewer-port", "0"]
+        options = ["--serve-web", "--web-viewer-port", str(self.port)]
+        # its own session: a Ctrl-C in the terminal reaches us alone, and we end the
+        # server after the last flush (ended first, it made the SDK log gRPC errors)
         self._process, (grpc, web) = _start(
-            "the Rerun web server", options, (_GRPC, _WEB), detach=False
+            "the Rerun web server", options, (_GRPC, _WEB), detach=True
         )
         self.grpc_url = _grpc_url(grpc)
         self.web_url = f"http://127.0.0.1:{web}/?url={quote(self.grpc_url, safe='')}"

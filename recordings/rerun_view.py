@@ -1,8 +1,9 @@
 """Showing runs in Rerun: replay a recording, or watch a run live.
 
 Outputs: an ``.rrd`` file, the web viewer served on 127.0.0.1, or the native viewer
-(which needs a display). A replay sends a whole recording at once, or paces it at
-``rate`` x real time; the live view sends what the run made every 0.1 s. Both go
+(which needs a display). A replay sends a whole recording at once (the viewer
+plays it, at ``rate`` x real time if asked); the live view sends what the run
+made every 0.1 s. Both go
 through ``recordings.rerun_rows`` (whose docstring lists the entity paths) and
 ``recordings.rerun_log``, so they show the same entities with the same blueprint.
 """
@@ -10,16 +11,14 @@ through ``recordings.rerun_rows`` (whose docstring lists the entity paths) and
 from __future__ import annotations
 
 import sys
-import time
 import uuid
 from contextlib import ExitStack, suppress
 from pathlib import Path
 
 import rerun as rr
 
-from bridge import keys
 from bridge.messages import to_dict
-from recordings.rerun_log import Live, recording_dt, send_recording
+from recordings.rerun_log import Live, send_recording
 from recordings.rerun_server import RerunError, WebServer, open_viewer, require_display
 
 APP_ID = "agv-fleet"
@@ -41,10 +40,18 @@ class Outputs:
     else the native viewer. A context manager: the file is complete and the web
     server gone when the block ends."""
 
-    def __init__(self, *, save: Path | str | None = None, web: bool = False, notify=sys.stderr):
+    def __init__(
+        self,
+        *,
+        save: Path | str | None = None,
+        web: bool = False,
+        web_port: int = 0,
+        notify=sys.stderr,
+    ):
         self.stream = rr.RecordingStream(APP_ID, recording_id=uuid.uuid4())
         self._save = save
         self._web = web
+        self._web_port = web_port
         self._notify = notify
         self._server: WebServer | None = None
         self._exit = ExitStack()
@@ -55,7 +62,7 @@ class Outputs:
             if self._save is not None:
                 sinks.append(rr.FileSink(str(self._save)))
             if self._web:
-                self._server = self._exit.enter_context(WebServer())
+                self._server = self._exit.enter_context(WebServer(self._web_port))
                 sinks.append(rr.GrpcSink(self._server.grpc_url))
             if not sinks:
                 sinks.append(rr.GrpcSink(open_viewer()))
@@ -77,18 +84,18 @@ class Outputs:
         try:
             self.stream.flush(timeout_sec=FLUSH_TIMEOUT)
         except RuntimeError as err:
-            # A Ctrl-C in the terminal ends the web server too: nobody is left to deliver to.
+            # The web server ended on its own (it has its own session, so a Ctrl-C does
+            # not reach it): nobody is left to deliver to.
             if self._server is None or self._server.running:
                 raise RerunError(f"Rerun did not get everything: {err}") from None
         finally:
             self.stream.disconnect()
 
-    def replay(self, recording, rate: float | None = None) -> None:
-        """Send a recording: all at once, or paced at ``rate`` x real time."""
-        if rate is None:
-            send_recording(self.stream, recording.messages)
-        else:
-            _paced(Live(self.stream, recording_dt(recording.messages)), recording.messages, rate)
+    def replay(self, recording, rate: float | None = None, follow: str | None = None) -> None:
+        """Send a whole recording; the viewer opens paused at its start, or playing it
+        at ``rate`` x real time, and on the tab of the AGV named ``follow``, if given.
+        (The viewer plays it: sending it paced made the web viewer fall behind.)"""
+        send_recording(self.stream, recording.messages, follow, rate)
 
     def hold(self) -> None:
         """With the web viewer: keep serving until Ctrl-C (or the server ends)."""
@@ -100,36 +107,31 @@ class Outputs:
             self._server.wait()
 
 
-def _paced(live: Live, messages, rate: float) -> None:
-    start = time.monotonic()
-    for m in messages:
-        if m.topic == keys.WORLD_TICK:
-            delay = start + m.data["time"] / rate - time.monotonic()
-            if delay > 0:
-                live.send()  # what happened up to now, before waiting for the next tick
-                time.sleep(delay)
-        live.feed(m.topic, m.data)
-    live.send()
-
-
-def save_rrd(recording, out_path: Path | str) -> None:
+def save_rrd(recording, out_path: Path | str, follow: str | None = None) -> None:
     """Convert a recording to an .rrd file that ``rerun OUT.rrd`` opens."""
     with Outputs(save=out_path) as out:
-        out.replay(recording)
+        out.replay(recording, follow=follow)
 
 
-def serve_web(recording, *, rate: float | None = None, notify=sys.stderr) -> None:
+def serve_web(
+    recording,
+    *,
+    rate: float | None = None,
+    follow: str | None = None,
+    port: int = 0,
+    notify=sys.stderr,
+) -> None:
     """Serve a recording in the web viewer on 127.0.0.1 (the URL goes to ``notify``)
-    until Ctrl-C."""
-    with Outputs(web=True, notify=notify) as out:
-        out.replay(recording, rate)
+    until Ctrl-C; ``port`` 0 lets the OS pick."""
+    with Outputs(web=True, web_port=port, notify=notify) as out:
+        out.replay(recording, rate, follow)
         out.hold()
 
 
-def spawn_viewer(recording, *, rate: float | None = None) -> None:
+def spawn_viewer(recording, *, rate: float | None = None, follow: str | None = None) -> None:
     """Show a recording in the native viewer (RerunError without a display)."""
     with Outputs() as out:
-        out.replay(recording, rate)
+        out.replay(recording, rate, follow)
 
 
 class LiveView:

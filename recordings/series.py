@@ -20,6 +20,7 @@ import numpy as np
 from bridge import keys
 from planner.errors import BadInputError
 from planner.grid_map import GridMap
+from recordings.map_frame import map_origin
 from recordings.reader import Recording, paused_gc
 
 AGV_FIELDS = ("x", "y", "theta", "vx", "vy", "omega", "radius", "plan_time_ms")
@@ -109,8 +110,7 @@ def map_grid(msg: dict) -> GridMap:
     turns a map message back into a map."""
     cells = np.frombuffer("".join(msg["rows"]).encode(), dtype=np.uint8)
     blocked = cells.reshape(msg["height"], msg["width"]) == ord("#")
-    origin = tuple(msg.get("origin") or (0.0, 0.0))
-    return GridMap.from_rows_top_down(blocked, msg["resolution"], msg["name"], origin)
+    return GridMap.from_rows_top_down(blocked, msg["resolution"], msg["name"], map_origin(msg))
 
 
 def _discs(per_tick: list[list[dict]], fields: tuple[str, ...], text: tuple[str, ...]) -> Discs:

@@ -7,13 +7,17 @@ Layout of a recording:
   (schema encoding ``jsonschema``, one schema record per type). A key with no
   message type (``bridge.keys.message_type`` gives None) still gets a channel,
   with no schema (schema id 0): the recording keeps what the bus carried.
-- log time = publish time = the message's simulated time in ns (tick * dt), so
-  two recordings of the same scenario line up message for message, whatever
-  the wall clock did (the in-process sink is ``record_sink``; a bus recorder
-  passes tick * dt to ``write_payload``).
-- metadata ``run`` at open and ``result`` at ``finish``; every value is a JSON
-  text (metadata values must be strings, and JSON keeps numbers and lists apart
-  from strings without guessing).
+- log time = publish time = the run's wall-clock start (run fact
+  ``log_time_zero_ns``) + the message's simulated time (tick * dt): viewers such
+  as Foxglove show real dates, and two recordings of one scenario still line up
+  message for message after subtracting their zero (callers pass sim time: the
+  in-process sink is ``record_sink``; a bus recorder passes tick * dt to
+  ``write_payload``). The sim time itself is in the messages.
+- beside them, the channels of ``recordings.foxglove`` (map, AGV frames and
+  bodies, plans on ``foxglove.*`` schemas) for Foxglove's 3D panel.
+- metadata ``run`` at open and ``result`` at ``finish``: a string value as it is,
+  anything else (numbers, lists, objects) as JSON text (metadata values must be
+  strings); a string that would read as JSON (``"1"``) is JSON-quoted.
 - attachment ``scenario.toml``: the scenario file as given.
 
 Durability: a chunk is closed when it holds ``CHUNK_BYTES`` or is
@@ -38,6 +42,7 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 from bridge.keys import message_type
 from bridge.messages import json_schema
+from recordings import foxglove
 
 CHUNK_BYTES = 256 * 1024
 """Uncompressed bytes per chunk: ~1000 AGV states, a few ms of a fast run."""
@@ -58,8 +63,17 @@ def tool_version() -> str:
         return "unknown"
 
 
-def _json_values(values: dict) -> dict[str, str]:
-    return {str(k): json.dumps(v, separators=(",", ":")) for k, v in values.items()}
+def _metadata_text(value) -> str:
+    if isinstance(value, str):
+        try:
+            json.loads(value)
+        except ValueError:
+            return value  # plain text reads back as itself
+    return json.dumps(value, separators=(",", ":"))
+
+
+def _metadata_values(values: dict) -> dict[str, str]:
+    return {str(k): _metadata_text(v) for k, v in values.items()}
 
 
 class RecordingWriter:
@@ -71,23 +85,26 @@ class RecordingWriter:
         self._mcap = Writer(self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD)
         self._mcap.start(library=f"agv-fleet/{tool_version()} {LIBRARY_IDENTIFIER}")
         self._channels: dict[str, int] = {}
-        self._schemas: dict[type, int] = {}
+        self._schemas: dict[object, int] = {}  # message class or foxglove schema name
+        self._foxglove = foxglove.FoxgloveChannels()
         self._pending = 0
         self._due = time.monotonic() + CHUNK_SECONDS
         self._closed = False
-        started = datetime.now(UTC)
+        self.log_time_zero_ns = time.time_ns()
+        started = datetime.fromtimestamp(self.log_time_zero_ns / 1e9, UTC)
         facts = {
             "run_id": uuid.uuid4().hex,
             **run_facts,
             "scenario": scenario_name,
             "version": tool_version(),
             "started_utc": started.isoformat(timespec="seconds"),
+            "log_time_zero_ns": self.log_time_zero_ns,
         }
         self.run_id = facts["run_id"]
-        self._mcap.add_metadata("run", _json_values(facts))
+        self._mcap.add_metadata("run", _metadata_values(facts))
         self._mcap.add_attachment(
-            create_time=int(started.timestamp() * 1e9),
-            log_time=0,
+            create_time=self.log_time_zero_ns,
+            log_time=self.log_time_zero_ns,
             name="scenario.toml",
             media_type="application/toml",
             data=scenario_text.encode(),
@@ -100,19 +117,31 @@ class RecordingWriter:
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def write(self, key: str, msg, log_time_ns: int) -> None:
+    def write(self, key: str, msg, sim_time_ns: int) -> None:
         """Record a message dataclass of ``bridge.messages`` on ``key``."""
-        self.write_payload(key, _encode(msg).encode(), log_time_ns)
+        self.write_payload(key, _encode(msg).encode(), sim_time_ns)
 
-    def write_payload(self, key: str, payload: bytes, log_time_ns: int) -> None:
-        """Record JSON bytes as they came from the bus (not decoded or checked)."""
+    def write_payload(self, key: str, payload: bytes, sim_time_ns: int) -> None:
+        """Record JSON bytes as they came from the bus (not checked), at the run's
+        start + ``sim_time_ns``, and what Foxglove needs of them."""
+        log_time = self.log_time_zero_ns + sim_time_ns
+        self._add(key, payload, log_time)
+        if self._foxglove.wants(key):
+            try:
+                made = self._foxglove.feed(key, json.loads(payload), log_time)
+            except (ValueError, KeyError, TypeError, IndexError):
+                made = []  # not a message of its type: recorded as it came, nothing drawn
+            for topic, message in made:
+                self._add(topic, foxglove.encode(message), log_time)
+        if self._pending >= CHUNK_BYTES or time.monotonic() >= self._due:
+            self._close_chunk()
+
+    def _add(self, key: str, payload: bytes, log_time: int) -> None:
         channel = self._channels.get(key)
         if channel is None:
             channel = self._register(key)
-        self._mcap.add_message(channel, log_time_ns, payload, log_time_ns)
+        self._mcap.add_message(channel, log_time, payload, log_time)
         self._pending += len(payload) + _RECORD_OVERHEAD
-        if self._pending >= CHUNK_BYTES or time.monotonic() >= self._due:
-            self._close_chunk()
 
     def flush_if_due(self) -> None:
         """Close the chunk in progress if it is ``CHUNK_SECONDS`` old (for idle loops)."""
@@ -122,7 +151,7 @@ class RecordingWriter:
     def finish(self, result: dict) -> None:
         """Store how the run ended (metadata ``result``, e.g. RunSummary.to_json()) and close."""
         self._close_chunk()
-        self._mcap.add_metadata("result", _json_values(result))
+        self._mcap.add_metadata("result", _metadata_values(result))
         self.close()
 
     def close(self) -> None:
@@ -145,6 +174,12 @@ class RecordingWriter:
                 data = json.dumps(json_schema(cls), separators=(",", ":")).encode()
                 schema = self._mcap.register_schema(cls.__name__, "jsonschema", data)
                 self._schemas[cls] = schema
+        elif key in foxglove.SCHEMA_OF:
+            name = foxglove.SCHEMA_OF[key]
+            schema = self._schemas.get(name, 0)
+            if not schema:
+                schema = self._mcap.register_schema(name, "jsonschema", foxglove.schema(name))
+                self._schemas[name] = schema
         channel = self._mcap.register_channel(key, "json", schema)
         self._channels[key] = channel
         return channel
@@ -157,7 +192,7 @@ class RecordingWriter:
 
 def record_sink(writer: RecordingWriter, dt: float) -> Callable[[str, object], None]:
     """A ``fleet.runtime.inprocess`` sink that records every message at its simulated time
-    (tick * dt; messages without a tick, the map, at 0)."""
+    (tick * dt; messages without a tick, the map, at 0) after the run's start."""
     dt_ns = round(dt * 1e9)
     write = writer.write
 

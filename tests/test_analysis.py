@@ -237,10 +237,14 @@ def test_a_real_run_agrees_with_the_worlds_summary(tmp_path):
     table = run_table(run)
     assert all(a.name in table for a in scenario.agvs)
     rows = list(csv.DictReader(io.StringIO(to_csv([run]))))
-    assert [r["name"] for r in rows] == [a.name for a in scenario.agvs]
-    assert float(rows[0]["distance"]) == pytest.approx(summary.agvs[0].distance)
+    assert [r["row"] for r in rows] == ["run"] + ["agv"] * len(scenario.agvs)
+    assert [r["name"] for r in rows[1:]] == [a.name for a in scenario.agvs]
+    assert float(rows[1]["distance"]) == pytest.approx(summary.agvs[0].distance)
+    assert float(rows[0]["distance"]) == pytest.approx(run.distance)  # the run's mean
+    assert rows[0]["finished"] == "yes" and rows[0]["truncated"] == "no"
+    assert not {"True", "False"} & {v for r in rows for v in r.values()}
 
-    written = save_plots(extract(rec), tmp_path / "plots", "crossing")
+    written = save_plots(extract(rec), tmp_path / "plots", "crossing", "crossing (fusion)")
     assert len(written) == 1 + len(scenario.agvs)
     for png in written:
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -11,6 +11,7 @@ import os
 import queue
 import re
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -27,11 +28,11 @@ from fleet.builtin import builtin_scenarios
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from recordings.reader import open_recording
-from recordings.rerun_rows import QUANTITIES, RowMaker, blocked_rectangles
+from recordings.rerun_rows import QUANTITIES, RowMaker
 from recordings.rerun_view import LiveView, Outputs, save_rrd
 from recordings.writer import RecordingWriter, record_sink
 
-AGV_PARTS = ("body", "heading", "trail", "plan", "plan/key_nodes", "dwa")
+AGV_PARTS = ("body", "heading", "label", "trail", "plan", "plan/key_nodes", "dwa", "pose")
 
 
 class Entity:
@@ -112,7 +113,17 @@ def test_a_saved_replay_has_the_map_every_agv_its_plans_and_velocities(corridor,
             series = replayed[f"/velocity/{q}/{name}"]
             assert len(series.rows) == len(states), q
             assert series.static == 1  # its name and colour in the plot
-    assert len(replayed["/events"].rows) == len(recording.of("world/event"))
+        assert replayed[f"/world/agv/{name}/start"].static >= 1  # its square, and style
+        assert replayed[f"/world/agv/{name}/goal"].static >= 1
+        assert len(replayed[f"/world/agv/{name}/pose"].rows) == len(ticks)  # the followed frame
+        assert len(replayed[f"/world/agv/{name}/label"].rows) == len(ticks)
+    world_events = [m.data["kind"] for m in recording.of("world/event")]
+    replans = [
+        m for n in names for m in recording.of(f"agv/{n}/plan") if m.data["reason"] != "initial"
+    ]
+    for kind in {*world_events, "replan"}:
+        expected = len(replans) if kind == "replan" else world_events.count(kind)
+        assert len(replayed.get(f"/events/{kind}", Entity()).rows) == expected, kind
 
 
 def test_velocity_rows_are_the_states_at_their_tick_time(corridor, replayed):
@@ -150,26 +161,77 @@ def test_the_live_view_shows_what_the_replay_shows(corridor, replayed):
         assert live[path].rows == entity.rows, path
 
 
-def test_blocked_cells_merge_into_rectangles_with_row_zero_at_the_bottom():
-    rows_top_down = ["#...", "##.#", "##.#"]
-    assert blocked_rectangles(rows_top_down) == [(0, 0, 2, 2), (0, 2, 1, 3), (3, 0, 4, 2)]
-
-
 def test_a_message_that_does_not_fit_its_topic_is_a_message_error():
     with pytest.raises(MessageError, match="world/tick"):
         RowMaker(0.1).feed("world/tick", {"tick": 0, "time": 0.0})
 
 
-def test_a_paced_replay_takes_its_time_and_sends_the_same_rows(corridor, replayed, tmp_path):
-    recording = corridor["recording"]
-    rate = 200.0
-    duration = recording.of("world/tick")[-1].data["time"] / rate
-    t0 = time.monotonic()
-    with Outputs(save=tmp_path / "paced.rrd") as out:
-        out.replay(recording, rate=rate)
-    assert time.monotonic() - t0 >= duration
-    paced = read_rrd(tmp_path / "paced.rrd")
-    assert {p: e.rows for p, e in paced.items()} == {p: e.rows for p, e in replayed.items()}
+def blueprint_values(path: Path, component: str) -> list:
+    """Every value of a blueprint component (e.g. ``TimePanelBlueprint:play_state``)."""
+    reader = RrdReader(str(path))
+    values = []
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        if component in batch.schema.names:
+            values += [v for v in batch.column(component).to_pylist() if v is not None]
+    return values
+
+
+PAUSED, PLAYING = [1], [2]  # rerun.blueprint.components.PlayState
+
+
+def test_a_replay_opens_paused_at_the_start_or_playing_at_its_rate(corridor, replayed, tmp_path):
+    with Outputs(save=tmp_path / "rate.rrd") as out:
+        out.replay(corridor["recording"], rate=4.0)
+    at_rate = read_rrd(tmp_path / "rate.rrd")
+    assert {p: e.rows for p, e in at_rate.items()} == {p: e.rows for p, e in replayed.items()}
+    assert blueprint_values(tmp_path / "rate.rrd", "TimePanelBlueprint:play_state") == [PLAYING]
+    assert blueprint_values(tmp_path / "rate.rrd", "TimePanelBlueprint:playback_speed") == [[4.0]]
+    save_rrd(corridor["recording"], tmp_path / "plain.rrd")
+    assert blueprint_values(tmp_path / "plain.rrd", "TimePanelBlueprint:play_state") == [PAUSED]
+
+
+def blueprint_entities(path: Path) -> dict[str, dict]:
+    """Blueprint entity path -> {component: last value}."""
+    reader = RrdReader(str(path))
+    entities: dict[str, dict] = {}
+    for chunk in reader.stream(store=reader.blueprints()[0]):
+        batch = chunk.to_record_batch()
+        for n in batch.schema.names:
+            if ":" not in n:  # components only, not the row ids and times
+                continue
+            values = [v for v in batch.column(n).to_pylist() if v is not None]
+            if values:
+                entities.setdefault(chunk.entity_path, {})[n] = values[-1]
+    return entities
+
+
+def test_the_map_view_fits_the_map_and_plots_show_the_whole_run(corridor, tmp_path):
+    save_rrd(corridor["recording"], tmp_path / "fit.rrd")
+    parts = blueprint_entities(tmp_path / "fit.rrd").values()
+    (map_data,) = [m.data for m in corridor["recording"].of("world/map")]
+    w, h = map_data["width"] * map_data["resolution"], map_data["height"] * map_data["resolution"]
+    bounds = [c["VisualBounds2D:range"][0] for c in parts if "VisualBounds2D:range" in c]
+    fitted = [b for b in bounds if b["x_range"][0] <= 0 < w <= b["x_range"][1]]
+    (fit,) = fitted  # the fleet map (the AGV tabs' views are smaller, around the AGV)
+    assert fit["y_range"][0] <= -h and fit["y_range"][1] >= 0  # y flipped by `world`
+    assert fit["x_range"][1] - fit["x_range"][0] < 1.2 * w  # and not much more
+    end_ns = round(corridor["recording"].of("world/tick")[-1].data["time"] * 1e9)
+    ranges = [c["TimeAxis:view_range"][0] for c in parts if "TimeAxis:view_range" in c]
+    assert ranges and all(r["start"] == 0 and r["end"] >= end_ns for r in ranges)
+
+
+def test_follow_opens_on_that_agvs_tab_which_follows_it(corridor, tmp_path):
+    save_rrd(corridor["recording"], tmp_path / "follow.rrd", follow="right")
+    parts = blueprint_entities(tmp_path / "follow.rrd")
+    (active,) = [
+        c["ContainerBlueprint:active_tab"]
+        for c in parts.values()
+        if "ContainerBlueprint:active_tab" in c
+    ]
+    assert parts[f"/{active[0]}"]["ContainerBlueprint:display_name"] == ["right"]
+    origins = {tuple(c.get("ViewBlueprint:space_origin", [""])) for c in parts.values()}
+    assert ("/world/agv/right/pose/follow",) in origins
 
 
 # --- the command line -----------------------------------------------------------------
@@ -204,32 +266,36 @@ def test_replay_save_writes_an_rrd_with_one_velocity_row_per_state(corridor, tmp
         assert len(entities[f"/velocity/vx/{name}"].rows) == len(states)
 
 
-def test_replay_without_a_display_or_save_or_web_exits_2_with_one_line(corridor):
+def test_replay_without_a_display_or_save_or_web_exits_3_with_one_line(corridor):
     done = agv_fleet("replay", str(corridor["mcap"]))
-    assert done.returncode == 2
+    assert done.returncode == 3  # an environment failure: nowhere to show it
     line = one_line(done.stderr)
     assert "no display" in line and "--save" in line and "--web" in line
 
 
-def test_replay_when_the_viewer_cannot_open_a_window_exits_2_with_one_line(corridor):
+def test_replay_when_the_viewer_cannot_open_a_window_exits_3_with_one_line(corridor):
     done = agv_fleet("replay", str(corridor["mcap"]), display=":4321")  # no X server there
-    assert done.returncode == 2
+    assert done.returncode == 3
     assert "the Rerun viewer did not start" in one_line(done.stderr)
 
 
 @pytest.mark.parametrize(
-    ("args", "message"),
+    ("args", "message", "status"),
     [
-        (["{tmp}/missing.mcap", "--save", "{tmp}/x.rrd"], "no such file"),
-        (["{tmp}/notes.mcap", "--save", "{tmp}/x.rrd"], "not an MCAP recording"),
-        (["{mcap}", "--save", "{tmp}/no/such/folder/x.rrd"], "No such file or directory"),
-        (["{mcap}", "--save", "{tmp}/x.rrd", "--rate", "2"], "--rate paces the viewer or --web"),
+        (["{tmp}/missing.mcap", "--save", "{tmp}/x.rrd"], "no such file", 2),
+        (["{tmp}/notes.mcap", "--save", "{tmp}/x.rrd"], "not an MCAP recording", 2),
+        (["{mcap}", "--save", "{tmp}/no/such/folder/x.rrd"], "No such file or directory", 3),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--rate", "2"], "--rate plays the viewer or --web", 2),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--port", "9876"], "--port is the web viewer's", 2),
+        (["{mcap}", "--web", "--port", "70000"], "--port 70000: not a TCP port", 2),
+        (["{mcap}", "--save", "{tmp}/x.rrd", "--follow", "nobody"], "no such AGV", 2),
     ],
 )
-def test_replay_errors_exit_2_with_one_line(corridor, tmp_path, args, message):
+def test_replay_errors_exit_with_one_line(corridor, tmp_path, args, message, status):
+    """Bad input exits 2; a file that cannot be written is an environment failure, 3."""
     (tmp_path / "notes.mcap").write_text("not a recording\n")
     done = agv_fleet("replay", *(a.format(tmp=tmp_path, mcap=corridor["mcap"]) for a in args))
-    assert done.returncode == 2
+    assert done.returncode == status
     assert message in one_line(done.stderr)
 
 
@@ -270,14 +336,34 @@ def alive(pid: int) -> bool:
         return False
 
 
-def test_replay_web_serves_on_loopback_only_until_ctrl_c_and_ends_its_server(corridor):
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def ctrl_c_in_the_terminal(process):
+    os.killpg(process.pid, signal.SIGINT)  # the whole foreground process group
+
+
+def sigterm(process):
+    process.send_signal(signal.SIGTERM)  # our process only, as `timeout` or systemd send it
+
+
+@pytest.mark.parametrize("stop", [ctrl_c_in_the_terminal, sigterm])
+def test_replay_web_serves_on_loopback_on_its_port_until_stopped_and_ends_its_server(
+    corridor, stop
+):
     env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    port = free_port()
+    command = ["replay", str(corridor["mcap"]), "--web", "--port", str(port)]
     process = subprocess.Popen(
-        [sys.executable, "-m", "fleet.cli", "replay", str(corridor["mcap"]), "--web"],
+        [sys.executable, "-m", "fleet.cli", *command],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        start_new_session=True,  # a process group of its own, as a terminal makes
     )
     lines: queue.Queue[str | None] = queue.Queue()
 
@@ -296,13 +382,18 @@ def test_replay_web_serves_on_loopback_only_until_ctrl_c_and_ends_its_server(cor
             seen.append(line)
         url = re.search(r"Rerun web viewer: (\S+)", "".join(seen)).group(1)
         assert urlparse(url).hostname == "127.0.0.1"
+        assert urlparse(url).port == port
         with urllib.request.urlopen(url, timeout=10) as page:
             assert page.status == 200
         children = Path(f"/proc/{process.pid}/task/{process.pid}/children").read_text()
         (server,) = map(int, children.split())
         assert listening_hosts(server) == {"0100007F"}  # 127.0.0.1, gRPC and web alike
-        process.send_signal(signal.SIGINT)
+        stop(process)
         assert process.wait(timeout=30) == 0
+        said = []
+        while (line := lines.get(timeout=10)) is not None:
+            said.append(line)
+        assert not [line for line in said if "ERROR" in line], said  # a quiet ending
         deadline = time.monotonic() + 10
         while alive(server) and time.monotonic() < deadline:
             time.sleep(0.05)

@@ -12,13 +12,12 @@ import json
 import sys
 from pathlib import Path
 
+from fleet import exit_codes
 from recordings.analysis import analyze
 from recordings.info import describe, describe_json
 from recordings.reader import Recording, RecordingError, open_recording
 from recordings.report import comparison_table, run_table, to_csv, to_json
-from recordings.series import SeriesError, extract
-
-EXIT_OK, EXIT_BAD_INPUT = 0, 2
+from recordings.series import extract
 
 
 def add_parsers(sub) -> None:
@@ -28,7 +27,13 @@ def add_parsers(sub) -> None:
         description="Describe a recording: size, duration, channels, AGVs, how the run ended.",
     )
     info.add_argument("recording", metavar="REC.mcap")
-    info.add_argument("--json", action="store_true", help="print one JSON object")
+    shown = info.add_mutually_exclusive_group()
+    shown.add_argument("--json", action="store_true", help="print one JSON object")
+    shown.add_argument(
+        "--scenario",
+        action="store_true",
+        help="print the scenario file stored in the recording (agv-fleet run can run it)",
+    )
     info.set_defaults(handler=run_info)
 
     analyze_parser = sub.add_parser(
@@ -36,13 +41,19 @@ def add_parsers(sub) -> None:
         help="run time, path, smoothness, clearance per AGV; compare recordings",
         description=(
             "Measure recordings per AGV and per run; with several recordings, compare "
-            "them side by side with the %% difference to the first."
+            "them side by side with the % difference to the first. Tables fit 100 "
+            "columns (--wide: every column); runs are named by scenario and algorithm."
         ),
     )
     analyze_parser.add_argument("recordings", nargs="+", metavar="REC.mcap")
     output = analyze_parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object")
-    output.add_argument("--csv", action="store_true", help="print one CSV row per AGV")
+    output.add_argument(
+        "--csv",
+        action="store_true",
+        help="print CSV: a 'run' row per recording, then an 'agv' row per AGV (yes/no booleans)",
+    )
+    output.add_argument("--wide", action="store_true", help="tables with every column")
     analyze_parser.add_argument(
         "--plots", metavar="DIR", type=Path, help="write PNG plots (map, v(t) and ω(t)) into DIR"
     )
@@ -57,25 +68,24 @@ def _open(path: str, command: str) -> Recording:
 
 
 def run_info(args: argparse.Namespace) -> int:
-    try:
-        rec = _open(args.recording, "info")
-    except RecordingError as err:
-        print(f"agv-fleet info: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+    rec = _open(args.recording, "info")
+    if args.scenario:
+        text = rec.scenario_text
+        if text is None:
+            raise RecordingError(f"{args.recording} holds no scenario")
+        sys.stdout.write(text if text.endswith("\n") else text + "\n")
+        return exit_codes.OK
     print(json.dumps(describe_json(rec)) if args.json else describe(rec))
-    return EXIT_OK
+    return exit_codes.OK
 
 
 def run_analyze(args: argparse.Namespace) -> int:
     runs = []
     for path in args.recordings:
-        try:
-            rec = _open(path, "analyze")
-            series = extract(rec)
-        except (RecordingError, SeriesError) as err:
-            print(f"agv-fleet analyze: {err}", file=sys.stderr)
-            return EXIT_BAD_INPUT
-        runs.append(analyze(rec, series))
+        rec = _open(path, "analyze")
+        series = extract(rec)
+        run = analyze(rec, series)
+        runs.append(run)
         if rec.undecodable:
             print(
                 f"agv-fleet analyze: {path}: skipped {rec.undecodable} undecodable messages",
@@ -86,18 +96,14 @@ def run_analyze(args: argparse.Namespace) -> int:
             # (the world, each AGV) imports this module through the CLI
             from recordings.plots import save_plots
 
-            try:
-                written = save_plots(series, args.plots, Path(path).stem)
-            except OSError as err:
-                print(f"agv-fleet analyze: cannot write plots: {err}", file=sys.stderr)
-                return EXIT_BAD_INPUT
+            written = save_plots(series, args.plots, Path(path).stem, run.label)
             print(f"agv-fleet analyze: {len(written)} plots in {args.plots}", file=sys.stderr)
     if args.json:
         print(json.dumps(to_json(runs)))
     elif args.csv:
         sys.stdout.write(to_csv(runs))
     else:
-        print("\n\n".join(run_table(r) for r in runs))
+        print("\n\n".join(run_table(r, wide=args.wide) for r in runs))
         if len(runs) > 1:
             print("\n" + comparison_table(runs))
-    return EXIT_OK
+    return exit_codes.OK

@@ -5,12 +5,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from bridge.messages import MessageError
-from fleet.cli.run import positive_float
-from recordings.reader import RecordingError, open_recording
-from recordings.rerun_view import RerunError, require_display, save_rrd, serve_web, spawn_viewer
-
-EXIT_OK, EXIT_BAD_INPUT = 0, 2
+from fleet import exit_codes
+from fleet.cli.arguments import UsageError, positive_float
+from fleet.runtime.launcher import sigterm_as_interrupt
+from recordings.reader import open_recording
+from recordings.rerun_view import require_display, save_rrd, serve_web, spawn_viewer
 
 
 def add_parsers(sub) -> None:
@@ -19,44 +18,62 @@ def add_parsers(sub) -> None:
         help="show a recording in Rerun",
         description=(
             "Show a recording in the Rerun viewer (needs a display), write it to an .rrd "
-            "file (--save) or serve the web viewer on 127.0.0.1 (--web). Exit 2 for a "
-            "recording that cannot be read or nowhere to show it."
+            "file (--save) or serve the web viewer on 127.0.0.1 (--web). SIGTERM ends it "
+            "like Ctrl-C, the Rerun server included. Exit 2 for a recording that cannot "
+            "be read or nowhere to show it."
         ),
     )
     p.add_argument("recording", metavar="REC.mcap", help="a recording of agv-fleet run")
     p.add_argument("--save", metavar="OUT.rrd", help="write a Rerun file (open: rerun OUT.rrd)")
     p.add_argument("--web", action="store_true", help="serve the web viewer until Ctrl-C")
     p.add_argument(
+        "--port",
+        type=int,
+        default=0,
+        metavar="N",
+        help="with --web: serve the web viewer on port N of 127.0.0.1 (default: a free port)",
+    )
+    p.add_argument(
+        "--follow",
+        metavar="AGV",
+        help="open the viewer on this AGV's tab (a view that follows it, and its plots)",
+    )
+    p.add_argument(
         "--rate",
         type=positive_float,
         metavar="F",
-        help="play at F x real time into the viewer or web viewer (default: all at once)",
+        help="open the viewer or web viewer playing at F x real time (default: paused at the "
+        "start of the run)",
     )
     p.set_defaults(handler=replay)
 
 
 def replay(args: argparse.Namespace) -> int:
     viewer = not (args.save or args.web)
-    try:
-        if args.rate and not (viewer or args.web):
-            raise RerunError("--rate paces the viewer or --web, not --save")
-        if viewer:
-            require_display()  # before reading what could not be shown
-        recording = open_recording(args.recording)
-        if recording.truncated:
-            print(
-                f"agv-fleet replay: {args.recording} is cut short ({recording.recovered_note}); "
-                "replaying what was recovered",
-                file=sys.stderr,
-            )
-        if args.save:
-            save_rrd(recording, args.save)
-            print(f"agv-fleet replay: wrote {args.save}", file=sys.stderr)
+    if args.rate and not (viewer or args.web):
+        raise UsageError("--rate plays the viewer or --web, not --save")
+    if args.port and not args.web:
+        raise UsageError("--port is the web viewer's: add --web")
+    if not 0 <= args.port <= 65535:
+        raise UsageError(f"--port {args.port}: not a TCP port")
+    if viewer:
+        require_display()  # before reading what could not be shown
+    recording = open_recording(args.recording)
+    if recording.truncated:
+        print(
+            f"agv-fleet replay: {args.recording} is cut short ({recording.recovered_note}); "
+            "replaying what was recovered",
+            file=sys.stderr,
+        )
+    if args.follow is not None and args.follow not in recording.agv_names():
+        known = ", ".join(recording.agv_names()) or "none"
+        raise UsageError(f"--follow {args.follow}: no such AGV in the recording ({known})")
+    if args.save:
+        save_rrd(recording, args.save, follow=args.follow)
+        print(f"agv-fleet replay: wrote {args.save}", file=sys.stderr)
+    with sigterm_as_interrupt():
         if args.web:
-            serve_web(recording, rate=args.rate)
+            serve_web(recording, rate=args.rate, follow=args.follow, port=args.port)
         elif viewer:
-            spawn_viewer(recording, rate=args.rate)
-    except (RecordingError, RerunError, MessageError) as err:
-        print(f"agv-fleet replay: {err}", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    return EXIT_OK
+            spawn_viewer(recording, rate=args.rate, follow=args.follow)
+    return exit_codes.OK

@@ -15,11 +15,11 @@ import contextlib
 import ctypes
 import os
 import signal
-import sys
 
 from setproctitle import setproctitle
 
 from bridge.bus import Bus
+from bridge.log import say
 from bridge.session import Login, open_client
 from fleet import exit_codes
 from fleet.runtime.agv_node import AgvNode
@@ -60,7 +60,7 @@ def serve_agvs(
                 _set_title(process_title(name))
                 code = _serve_one(scenario, name, *options, logins.get(name))
             except BaseException as err:  # os._exit below would swallow it silently
-                print(f"agv-fleet agv {name}: crashed: {err!r}", flush=True, file=sys.stderr)
+                say(f"agv-fleet agv {name}: crashed: {err!r}")
             finally:
                 os._exit(code)
         children[pid] = name
@@ -85,7 +85,7 @@ def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, l
         with open_client(connect, connect_timeout, zenoh_config, login) as session:
             serve_agv(scenario, name, Bus(session, prefix))
     except AgvFleetError as err:
-        print(f"agv-fleet agv {name}: {err}", flush=True, file=sys.stderr)
+        say(f"agv-fleet agv {name}: {err}")
         return exit_codes.for_error(err)
     except KeyboardInterrupt:
         return exit_codes.INTERRUPTED
@@ -114,7 +114,7 @@ def _wait_for(children: dict[int, str]) -> int:
         name = children.pop(pid, None)
         code = os.waitstatus_to_exitcode(status)
         if code < 0 and not ending:
-            print(f"agv-fleet agv {name}: killed by signal {-code}", flush=True, file=sys.stderr)
+            say(f"agv-fleet agv {name}: killed by signal {-code}")
         worst = max(worst, 128 - code if code < 0 else code)
     return worst
 

@@ -90,7 +90,7 @@ def run_fleet(
     run_dir = tempfile.mkdtemp(prefix="agv-fleet-")  # 0700: this user's only
     endpoint = fresh_endpoint(options.transport, run_dir)
     children: list[subprocess.Popen] = []
-    with _children_ended(children), _sigterm_as_interrupt():
+    with _children_ended(children), sigterm_as_interrupt():
         try:
             names = [agv.name for agv in scenario.agvs]
             guard, child_files = write_run_credentials(run_dir, names, prefix)
@@ -177,7 +177,7 @@ def _children_ended(children: list[subprocess.Popen]):
 
 
 @contextmanager
-def _sigterm_as_interrupt():
+def sigterm_as_interrupt():
     """SIGTERM ends the run like Ctrl-C, so the children are cleaned up."""
 
     def handler(signum, frame):
