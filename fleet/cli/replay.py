@@ -20,7 +20,7 @@ def add_parsers(sub) -> None:
             "Show a recording in the Rerun viewer (needs a display), write it to an .rrd "
             "file (--save) or serve the web viewer on 127.0.0.1 (--web). SIGTERM ends it "
             "like Ctrl-C, the Rerun server included. Exit 2 for a recording that cannot "
-            "be read or nowhere to show it."
+            "be read, 3 when there is nowhere to show it."
         ),
     )
     p.add_argument("recording", metavar="REC.mcap", help="a recording of agv-fleet run")
