@@ -161,16 +161,6 @@ class GridMap:
         """(H+1, W+1) int array: prefix[r, c] = obstacles in rows < r and cols < c."""
         return self._prefix
 
-    def obstacle_centres(self) -> np.ndarray:
-        """(N, 2) world coordinates of every obstacle cell's centre."""
-        rows, cols = np.nonzero(self.blocked)
-        return np.column_stack(
-            (
-                self.origin[0] + (cols + 0.5) * self.resolution,
-                self.origin[1] + (rows + 0.5) * self.resolution,
-            )
-        )
-
     def with_blocked(self, cells) -> GridMap:
         """A copy with extra obstacle cells (col, row), e.g. temporary obstacles seen so far."""
         blocked = self.blocked.copy()

@@ -74,20 +74,6 @@ def extract_key_nodes(grid: GridMap, cells: list[Cell], safety_distance: float) 
     return nodes
 
 
-def segment_clear(grid: GridMap, a: Cell, b: Cell, safety_distance: float) -> bool:
-    """Whether the segment between two cell centres is a safe shortcut (see module doc)."""
-    return bool(
-        segment_is_clear(
-            grid.blocked.view(np.uint8),
-            float(a[0]),
-            float(a[1]),
-            float(b[0]),
-            float(b[1]),
-            safety_distance / grid.resolution,
-        )
-    )
-
-
 @numba.njit(cache=True)
 def _point_segment_distance(px, py, x0, y0, x1, y1):
     dx = x1 - x0

@@ -7,6 +7,7 @@ import io
 from dataclasses import asdict, fields
 
 from recordings.analysis import AgvAnalysis, RunAnalysis, compare, json_ready
+from recordings.text_table import text_table
 
 TABLE_WIDTH = 100  # columns the default tables fit in (--wide: every column)
 
@@ -37,23 +38,6 @@ def _cell(value, fmt: str) -> str:
     return "-" if value is None else fmt.format(value)
 
 
-def _table(header: list[list[str]], rows: list[list[str]], right_from: int = 1) -> str:
-    """Columns padded to width under a header of one or more lines; numbers (from
-    column ``right_from``) right-aligned."""
-    every = [*header, *rows]
-    widths = [max(len(r[i]) for r in every) for i in range(len(every[0]))]
-
-    def line(row):
-        cells = [
-            c.ljust(w) if i < right_from else c.rjust(w)
-            for i, (c, w) in enumerate(zip(row, widths, strict=True))
-        ]
-        return "  ".join(cells).rstrip()
-
-    rule = "  ".join("-" * w for w in widths)
-    return "\n".join([*(line(h) for h in header), rule, *(line(r) for r in rows)])
-
-
 def _state(run: RunAnalysis) -> str:
     """How the run ended, in the words ``agv-fleet run`` used ("time limit", ...)."""
     state = run.end_reason or "ended" if run.finished else "did not finish"
@@ -72,7 +56,7 @@ def run_table(run: RunAnalysis, wide: bool = False) -> str:
         f"{run.collisions} collisions, run time {run.run_time:.1f} s, {run.ticks} ticks "
         f"({_state(run)})"
     )
-    table = _table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
+    table = text_table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
     note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
     return f"{table}\n{line}{note}"
 
@@ -89,7 +73,7 @@ def comparison_table(runs: list[RunAnalysis]) -> str:
         changes = [_cell(c, "{:+.1f} %") for c in m.change_pct[1:]]
         rows.append([name, *values, *changes])
     legend = "\n".join(f"[{i + 1}] {r.label}: {r.path}" for i, r in enumerate(runs))
-    return _table([header], rows) + "\n" + legend
+    return text_table([header], rows) + "\n" + legend
 
 
 def to_json(runs: list[RunAnalysis]) -> dict:

@@ -3,9 +3,11 @@ interrupt: the convention of fleet.exit_codes, as the README's table states it."
 
 from __future__ import annotations
 
+import json
 import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -88,15 +90,29 @@ def test_exit_status(files, capsys, argv, expected):
 
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
-def test_an_interrupted_run_exits_130_and_says_so(signum):
+def test_an_interrupted_run_exits_130_and_names_its_recording_and_the_state_so_far(
+    signum, tmp_path
+):
+    path = tmp_path / "cut.mcap"
     proc = subprocess.Popen(
-        [*CLI, "run", "corridor", "--realtime", "1", "-q", "--no-record"],
+        [*CLI, "run", "corridor", "--realtime", "4", "-q", "-o", str(path)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
     agv_pid("right")
+    time.sleep(1.5)  # a few simulated seconds
     proc.send_signal(signum)
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == exit_codes.INTERRUPTED
-    assert "interrupted" in err and "Traceback" not in err
+    assert "Traceback" not in err and err.rstrip().endswith("interrupted")
+    assert "so far:" in err and "left" in err and "right" in err  # the partial summary
+    assert f"recorded up to the interrupt: {path}" in err and path.exists()
+
+
+def test_run_json_names_the_recording(tmp_path, capsys):
+    path = tmp_path / "c.mcap"
+    assert main(["run", "corridor", "--in-process", "-q", "--json", "-o", str(path)]) == 0
+    assert json.loads(capsys.readouterr().out)["recording"] == str(path)
+    assert main(["run", "corridor", "--in-process", "-q", "--json", "--no-record"]) == 0
+    assert json.loads(capsys.readouterr().out)["recording"] is None

@@ -13,6 +13,7 @@ from planner.errors import BadInputError
 from planner.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up
 from planner.map_io import UNKNOWN_CHOICES, load_map
 from planner.profiles import DEFAULT, PROFILES
+from recordings.text_table import text_table
 
 
 def add_parser(sub) -> None:
@@ -121,35 +122,18 @@ def plan_json(r: PlanResult) -> dict:
 
 
 def plans_table(results: list[PlanResult]) -> str:
-    header = (
-        "algorithm", "length (m)", "turns", "turning angle (deg)", "clearance (m)",
-        "expansions", "time (ms)",
-    )  # fmt: skip
-    rows = [header]
-    for r in results:
-        if r.found:
-            rows.append(
-                (
-                    r.algorithm,
-                    f"{r.length:.2f}",
-                    str(r.turns),
-                    f"{r.turning_angle_deg:.1f}",
-                    f"{r.clearance:.2f}",
-                    str(r.expansions),
-                    f"{r.time_s * 1e3:.2f}",
-                )
-            )
-        else:
-            rows.append(
-                (r.algorithm, "no path", "-", "-", "-", str(r.expansions), f"{r.time_s * 1e3:.2f}")
-            )
-    widths = [max(len(row[i]) for row in rows) for i in range(len(header))]
-    lines = [
-        "  ".join(
-            cell.ljust(w) if i == 0 else cell.rjust(w)
-            for i, (cell, w) in enumerate(zip(row, widths, strict=True))
-        )
-        for row in rows
+    header = [
+        ["algorithm", "length", "turns", "turning angle", "clearance", "expansions", "time"],
+        ["", "m", "", "deg", "m", "", "ms"],
     ]
-    lines.insert(1, "  ".join("-" * w for w in widths))
-    return "\n".join(lines)
+    rows = []
+    for r in results:
+        time_ms = f"{r.time_s * 1e3:.2f}"
+        if r.found:
+            rows.append([
+                r.algorithm, f"{r.length:.2f}", str(r.turns), f"{r.turning_angle_deg:.1f}",
+                f"{r.clearance:.2f}", str(r.expansions), time_ms,
+            ])  # fmt: skip
+        else:
+            rows.append([r.algorithm, "no path", "-", "-", "-", str(r.expansions), time_ms])
+    return text_table(header, rows)

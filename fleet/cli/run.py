@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from contextlib import ExitStack
 from pathlib import Path
 
@@ -14,6 +15,8 @@ from fleet.cli.arguments import UsageError, positive_float
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.runtime.progress import Progress
+from fleet.runtime.summary import summarize
+from fleet.runtime.world import World
 from fleet.scenario import ScenarioError, load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
 from planner.profiles import PROFILES
@@ -118,7 +121,7 @@ def run(args: argparse.Namespace) -> int:
         record_path = Path(args.output) if args.output else default_recording_path(scenario.name)
     if (args.rerun_save or args.rerun_web) and not args.rerun:
         raise UsageError("--rerun-save and --rerun-web go with --rerun")
-    progress = None if args.quiet else Progress(scenario)
+    watch = _Watch(None if args.quiet else Progress(scenario))
     with ExitStack() as stack:
         try:
             view = None
@@ -126,16 +129,47 @@ def run(args: argparse.Namespace) -> int:
                 view = stack.enter_context(
                     LiveView(scenario.dt, save=args.rerun_save, web=args.rerun_web)
                 )
-            summary = _run(args, scenario, record_path, progress, view)
+            summary = _run(args, scenario, record_path, watch, view)
         except RerunError as err:  # its hints name replay's flags: say run's
             hint = str(err).replace("--save", "--rerun-save").replace("--web", "--rerun-web")
             raise RerunError(hint) from None
+        except KeyboardInterrupt:
+            _say_interrupted(watch, record_path)
+            raise
         if record_path:
             print(f"recorded to {record_path}", file=sys.stderr)
-        print(json.dumps(summary.to_json()) if args.json else summary.table(), flush=True)
+        if args.json:
+            report = {**summary.to_json(), "recording": str(record_path) if record_path else None}
+            print(json.dumps(report), flush=True)
+        else:
+            print(summary.table(), flush=True)
         if view is not None and args.rerun_web:
             view.hold()
     return exit_codes.OK if summary.success else exit_codes.NOT_SUCCEEDED
+
+
+class _Watch:
+    """The progress callback, keeping the world it last saw for a partial summary."""
+
+    def __init__(self, progress: Progress | None):
+        self.progress = progress
+        self.world: World | None = None
+        self.started = time.perf_counter()
+
+    def __call__(self, world: World) -> None:
+        self.world = world
+        if self.progress:
+            self.progress(world)
+
+
+def _say_interrupted(watch: _Watch, record_path: Path | None) -> None:
+    """On Ctrl-C or SIGTERM: where the run got to, and what the recording holds."""
+    if watch.world is not None:
+        partial = summarize(watch.world, time.perf_counter() - watch.started)
+        print(f"interrupted at t = {watch.world.time:.1f} s; so far:", file=sys.stderr)
+        print(partial.table(), file=sys.stderr)
+    if record_path and record_path.exists():
+        print(f"recorded up to the interrupt: {record_path}", file=sys.stderr)
 
 
 def _run(args, scenario, record_path, progress, view):

@@ -10,6 +10,7 @@ from planner.agv_status import ARRIVED, FINISHED
 from planner.fusion import GLOBAL_ALGORITHM
 from planner.global_planner import plan_global
 from planner.grid_map import MapError
+from recordings.text_table import text_table
 
 
 @dataclass(frozen=True)
@@ -69,31 +70,30 @@ class RunSummary:
         }
 
     def table(self) -> str:
-        header = (
-            "AGV", "status", "arrival (s)", "distance (m)", "route (m)", "collisions",
-            "min clearance (m)",
-        )  # fmt: skip
-        rows = [header]
-        for a in self.agvs:
-            rows.append(
-                (
-                    a.name,
-                    a.status,
-                    "-" if a.arrival_time is None else f"{a.arrival_time:.1f}",
-                    f"{a.distance:.2f}",
-                    "-" if a.route_length is None else f"{a.route_length:.2f}",
-                    str(a.collisions),
-                    f"{a.min_clearance:.2f}",
-                )
-            )
-        widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
-        lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
-        lines.insert(1, "  ".join("-" * w for w in widths))
-        arrived = sum(a.status == "arrived" for a in self.agvs)
-        lines.append(
+        """Per AGV, then the run in a line, then each AGV that failed with its reason."""
+        header = [
+            ["AGV", "status", "arrival", "distance", "route", "collisions", "min clearance"],
+            ["", "", "s", "m", "m", "", "m"],
+        ]
+        rows = [
+            [
+                a.name,
+                a.status,
+                "-" if a.arrival_time is None else f"{a.arrival_time:.1f}",
+                f"{a.distance:.2f}",
+                "-" if a.route_length is None else f"{a.route_length:.2f}",
+                str(a.collisions),
+                f"{a.min_clearance:.2f}" if math.isfinite(a.min_clearance) else "-",
+            ]
+            for a in self.agvs
+        ]
+        arrived = sum(a.status == ARRIVED for a in self.agvs)
+        lines = [
+            text_table(header, rows, right_from=2),
             f"{self.scenario}: {arrived}/{len(self.agvs)} arrived, {self.collisions} collisions, "
-            f"{self.sim_time:.1f} s simulated in {self.wall_time:.2f} s ({self.end_reason})"
-        )
+            f"{self.sim_time:.1f} s simulated in {self.wall_time:.2f} s ({self.end_reason})",
+        ]
+        lines += [f"{a.name} failed: {a.failure}" for a in self.agvs if a.failure]
         return "\n".join(lines)
 
 
