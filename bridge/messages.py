@@ -44,6 +44,7 @@ class AgvState:
     status: str = "driving"
     target: list[float] | None = None
     plan_time_ms: float = 0.0
+    failure: str = ""  # why, when status is "failed"
 
 
 @dataclass

@@ -61,6 +61,7 @@ class AgvNode:
         new_pose = step_pose(pose, step.command, self.scenario.dt)
         state = self._state(tick.tick + 1, new_pose, step.command, step.status, step.target)
         state.plan_time_ms = step.plan_time_s * 1e3
+        state.failure = self.controller.failure if step.status == "failed" else ""
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(

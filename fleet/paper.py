@@ -28,11 +28,12 @@ from bridge.keys import WORLD_MAP, agv_plan
 from fleet.agv_node import plan_message
 from fleet.builtin import bundled_maps
 from fleet.inprocess import run_in_process
-from fleet.scenario import load_scenario, with_algorithm
+from fleet.scenario import load_scenario, with_algorithm, with_profile
 from fleet.world import map_message
 from planner.global_planner import plan_global, warm_up
 from planner.grid_map import GridMap
 from planner.map_io import load_matrix_text
+from planner.profiles import PAPER
 from planner.random_map import random_map
 from recordings.analysis import RunAnalysis, analyze
 from recordings.plan_metrics import MapPlans, map_plans
@@ -175,7 +176,7 @@ def record_random50(plan_dir: Path, wanted: int, log: Log) -> list[Path]:
 
 
 def record_fleet_run(fleet_dir: Path, scenario_name: str, algorithm: str) -> Path:
-    scenario = with_algorithm(load_scenario(scenario_name), algorithm)
+    scenario = with_profile(with_algorithm(load_scenario(scenario_name), algorithm), PAPER)
     path = fleet_dir / f"{scenario_name}-{algorithm}.mcap"
     facts = {"mode": "in-process", "algorithm": algorithm, "experiment": "agv-fleet paper"}
     with RecordingWriter(

@@ -29,6 +29,7 @@ from planner.dwa import DwaConfig
 from planner.fusion import VARIANTS, FusionConfig
 from planner.grid_map import GridMap, MapError
 from planner.map_io import load_map, parse_text_grid
+from planner.profiles import PROFILES
 from planner.random_map import random_map
 
 TOP_KEYS = (
@@ -204,10 +205,12 @@ def _parse_config(
     """A FusionConfig from a [planner] table and vehicle keys (user units)."""
     dwa_args: dict = {"dt": dt}
     fusion_args: dict = {}
-    check_keys(planner, ("algorithm", *PLANNER_KEYS, *FUSION_KEYS), planner_where)
+    check_keys(planner, ("algorithm", "profile", *PLANNER_KEYS, *FUSION_KEYS), planner_where)
     for key in planner:
         if key == "algorithm":
             fusion_args[key] = get_str(planner, key, planner_where, choices=VARIANTS)
+        elif key == "profile":
+            fusion_args[key] = get_str(planner, key, planner_where, choices=PROFILES)
         elif key in PLANNER_KEYS:
             field_name, scale = PLANNER_KEYS[key]
             dwa_args[field_name] = get_number(planner, key, planner_where, positive=True) * scale
@@ -303,4 +306,12 @@ def with_algorithm(scenario: Scenario, algorithm: str) -> Scenario:
     if algorithm not in VARIANTS:
         raise ScenarioError(f"unknown algorithm {algorithm!r}: choose one of {', '.join(VARIANTS)}")
     agvs = tuple(replace(a, config=replace(a.config, algorithm=algorithm)) for a in scenario.agvs)
+    return replace(scenario, agvs=agvs)
+
+
+def with_profile(scenario: Scenario, profile: str) -> Scenario:
+    """The same scenario with every AGV planning with the planner ``profile``."""
+    if profile not in PROFILES:
+        raise ScenarioError(f"unknown profile {profile!r}: choose one of {', '.join(PROFILES)}")
+    agvs = tuple(replace(a, config=replace(a.config, profile=profile)) for a in scenario.agvs)
     return replace(scenario, agvs=agvs)

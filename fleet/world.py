@@ -92,7 +92,7 @@ class World:
             reply.tick = self.tick
             self.states[name] = reply
             if reply.status in DONE_STATUSES and record.status not in DONE_STATUSES:
-                self._finish(name, reply.status, reply.status)
+                self._finish(name, reply.status, reply.failure or reply.status)
         self._refresh_temporary()
         self._check_contacts()
         if not self._running():
