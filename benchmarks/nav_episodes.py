@@ -19,6 +19,7 @@ reference for driven / shortest), on the distance-field lattice.
 from __future__ import annotations
 
 import heapq
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -35,8 +36,14 @@ from planner.random_map import random_map
 SIZE = 20
 RADIUS = 0.3
 SENSING_RADIUS = 5.0
-TABLE1 = {"max_speed": 2.0, "max_accel": 0.2, "max_omega": math.radians(20), "max_alpha": math.radians(50)}  # fmt: skip
-REALISTIC = {"max_speed": 1.5, "max_accel": 1.0, "max_omega": math.radians(60), "max_alpha": math.radians(120)}  # fmt: skip
+TABLE1 = {
+    "max_speed": 2.0, "max_accel": 0.2, "max_omega": math.radians(20),
+    "max_alpha": math.radians(50),
+}  # fmt: skip
+REALISTIC = {
+    "max_speed": 1.5, "max_accel": 1.0, "max_omega": math.radians(60),
+    "max_alpha": math.radians(120),
+}  # fmt: skip
 VEHICLES = {"table1": TABLE1, "realistic": REALISTIC}
 NOMINAL_SPEED = {"table1": 0.8, "realistic": 1.2}  # m/s, to time walkers and late walls
 _STEPS = [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)]
@@ -62,7 +69,7 @@ class Episode:
             name=f"nav-{self.seed}",
             description=self.events,
             dt=0.1,
-            time_limit=round(60 + 6 * self.shortest),
+            time_limit=round(40 + 4 * self.shortest),
             sensing_radius=SENSING_RADIUS,
             grid=self.grid,
             agvs=(AgvSpec("agv", self.start, self.goal, 0.0, config),),
@@ -113,7 +120,7 @@ def body_path(grid: GridMap, start, goal, radius: float = RADIUS) -> list[tuple[
 
 
 def path_length(path) -> float:
-    return float(sum(math.dist(a, b) for a, b in zip(path[:-1], path[1:], strict=True)))
+    return float(sum(math.dist(a, b) for a, b in itertools.pairwise(path)))
 
 
 def _recess(blocked: np.ndarray, rng, depth: int, keep) -> tuple[int, int] | None:

@@ -36,7 +36,8 @@ profile's ``LocalBehaviour.evade``, is the evasive fallback of
 ``planner/evasion.py``.
 
 The default profile adds a term to Eq. (10), normalised like the others:
-``facing`` (pi - |atan2(vy, vx)|: the body faces its direction of travel);
+``facing`` (pi - |atan2(vy, vx)|: the body faces its direction of travel) and
+``on_route`` (the trajectory stays near the global route's current segment);
 and it picks, among the samples scoring near the best, the one that changes
 the last cycle's acceleration least (``steady_choice``), so the chosen
 acceleration stops flipping every cycle.
@@ -327,6 +328,19 @@ def facing(commands: np.ndarray) -> np.ndarray:
     return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
 
 
+def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
+    """cap - the largest distance of each trajectory (N, K) from the route ``segment``
+    (capped at ``cap``): trajectories that stay on the global route score highest, so
+    the AGV lines up with a narrow passage the route goes through before it gets there."""
+    (ax, ay), (bx, by) = segment
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    t = np.zeros_like(xs) if length2 < _EPS else ((xs - ax) * dx + (ys - ay) * dy) / length2
+    t = np.clip(t, 0.0, 1.0)
+    off = np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
+    return cap - np.minimum(off, cap)
+
+
 def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarray:
     """(N,) how much each sample changes the last cycle's acceleration, in m/s per period.
 
@@ -379,6 +393,7 @@ class DwaPlanner:
         stop: bool = False,
         previous: Command | None = None,
         approach: bool = False,
+        segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
     ) -> DwaResult:
         """One control cycle from ``pose`` with current ``command`` towards the local target.
 
@@ -389,6 +404,7 @@ class DwaPlanner:
         cycle before (for the steadiness term; None: the current one).
         ``approach``: the final approach, where the dist term is replaced by
         nearness to the target (goals in docks and pockets have little clearance).
+        ``segment``: the global route's segment to the target, for the ``on_route`` term.
         """
         cfg = self.config
         field = self.distance_field
@@ -442,6 +458,10 @@ class DwaPlanner:
             reached,
             self._extra(commands[ok]),
         )
+        if segment is not None and self.behaviour.route_weight > 0:
+            g = g + self.behaviour.route_weight * normalised(
+                on_route(xs[ok], ys[ok], segment, cfg.clearance_cap)
+            )
         if self.behaviour.steady_tolerance > 0:
             change = jerk(commands[ok], command, command if previous is None else previous)
             best = ok[steady_choice(g, change, self.behaviour.steady_tolerance)]

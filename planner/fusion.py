@@ -124,6 +124,7 @@ class FusionController:
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
         self._recoveries_done = 0
+        self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
 
     # --- planning -----------------------------------------------------------------
@@ -144,6 +145,7 @@ class FusionController:
         if self.config.algorithm == "dwa":
             self.targets = [self.goal]
             self.target_index = 0
+            self._planned_at = position
             return None
         known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
         try:
@@ -152,7 +154,7 @@ class FusionController:
                 position,
                 self.goal,
                 _GLOBAL_ALGORITHM[self.config.algorithm],
-                safety_distance=self.config.safety_distance,
+                safety_distance=self._safety_distance(),
             )
         except MapError as err:  # e.g. standing in a cell now known to be blocked
             plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
@@ -164,10 +166,20 @@ class FusionController:
             return plan
         # the start cell's centre is not a target: the AGV is already there; for
         # astar-dwa the key nodes are the traditional path's turning points
+        self._planned_at = position
         self.targets = list(plan.key_nodes[1:]) or [self.goal]
         self.targets[-1] = self.goal
         self.target_index = 0
         return plan
+
+    def _safety_distance(self) -> float:
+        """The paper's safety distance to obstacle-cell centres; with ``body_safe_segments``
+        at least the AGV radius plus half a cell diagonal, so that every segment between
+        key nodes leaves the disc clear of the cell squares (until the costmap does it)."""
+        if not self.behaviour.body_safe_segments:
+            return self.config.safety_distance
+        body = self.config.dwa.radius + self.grid.resolution * math.sqrt(0.5)
+        return max(self.config.safety_distance, body)
 
     def see(self, cells) -> bool:
         """Temporary obstacle cells inside the sensing radius; True when any is new."""
@@ -230,10 +242,15 @@ class FusionController:
         )
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
-            approach=approach,
+            approach=approach, segment=(self._segment_start(), target),
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
+
+    def _segment_start(self) -> Point:
+        """Where the route's current segment starts: the previous key node, or where the
+        AGV was when it planned."""
+        return self.targets[self.target_index - 1] if self.target_index else self._planned_at
 
     def _turn(self, pose, command, now) -> ControlStep:
         """The initial turn towards the first key node, as motion within the limits."""

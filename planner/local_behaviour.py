@@ -21,7 +21,9 @@ class LocalBehaviour:
     recover: bool  # stalled: bounded recoveries (replan, wait, back off, rotate), then failed
     smooth_arrival: bool  # arrived = inside the tolerance and stopped, braking within limits
     recorded_turn: bool  # the initial heading turn is driven within omega/alpha limits
+    body_safe_segments: bool  # key-node segments keep the body clear (no costmap yet)
     final_approach: bool  # near the goal: score by the distance to it, not by clearance
+    route_weight: float  # weight of the term keeping trajectories on the global route
     face_travel_weight: float  # weight of the term facing the body along its travel
     steady_tolerance: float  # keep the acceleration unless this near the best (score spread)
 
@@ -38,8 +40,10 @@ def local_behaviour(profile: str, *, free_heading: bool = False) -> LocalBehavio
         recover=on,
         smooth_arrival=on,
         recorded_turn=on,
+        body_safe_segments=on,
         final_approach=on,
-        face_travel_weight=1.0 if on and not free_heading else 0.0,
+        route_weight=0.3 if on else 0.0,
+        face_travel_weight=0.3 if on and not free_heading else 0.0,
         steady_tolerance=STEADY_TOLERANCE if on else 0.0,
     )
 
