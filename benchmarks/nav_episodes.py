@@ -123,6 +123,20 @@ def path_length(path) -> float:
     return float(sum(math.dist(a, b) for a, b in itertools.pairwise(path)))
 
 
+def _aside(grid: GridMap, route, point) -> tuple[float, float] | None:
+    """The free cell centre nearest ``point`` that is at least 1.5 m from every route point."""
+    route_xy = np.asarray(route)
+    best, best_d = None, math.inf
+    for row in range(grid.height):
+        for col in range(grid.width):
+            centre = grid.centre_of((col, row))
+            if grid.blocked[row, col] or math.dist(centre, point) >= best_d:
+                continue
+            if np.hypot(*(route_xy - centre).T).min() >= 1.5:
+                best, best_d = centre, math.dist(centre, point)
+    return best
+
+
 def _recess(blocked: np.ndarray, rng, depth: int, keep) -> tuple[int, int] | None:
     """Carve a 1-cell-wide recess ``depth`` cells deep; its innermost cell, or None."""
     for _ in range(200):
@@ -188,13 +202,15 @@ def make_episode(seed: int) -> Episode | None:
         start_at = max(0.0, meet - half / walk)
         moving.append(MovingObstacle("crossing", 0.35, tuple(ends), walk, "bounce", start_at))
         events.append("crossing")
-    if rng.random() < 0.4:  # a walker coming head-on along the route
+    if rng.random() < 0.4:  # a walker coming head-on along the route, then stepping aside
         k = int(rng.integers(len(route) // 2, len(route) - 1))
-        back = route[max(0, k - 80) : k + 1 : 10][::-1]
-        if len(back) >= 2:
+        j = max(30, k - 80)  # it turns off at least 3 m before the start
+        aside = _aside(grid, route, route[j])
+        if k - j >= 10 and aside is not None:
             walk = float(rng.uniform(0.3, 0.8))
+            points = (*route[j : k + 1 : 10][::-1], aside)
             start_at = float(rng.uniform(0, 20))
-            moving.append(MovingObstacle("head-on", 0.35, tuple(back), walk, "once", start_at))
+            moving.append(MovingObstacle("head-on", 0.35, points, walk, "once", start_at))
             events.append("head-on")
     if rng.random() < 0.6:  # a wall across the route
         late = rng.random() < 0.5

@@ -429,10 +429,10 @@ class DwaPlanner:
         ok = np.flatnonzero(mask)
         if ok.size == 0:
             if self.behaviour.evade:
-                first, lowest = contact_times(
+                times = contact_times(
                     xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
                 )
-                best = evasive_index(first, lowest)
+                best = evasive_index(*times)
                 chosen = tuple(float(v) for v in commands[best])
                 path = (xs[best], ys[best], thetas[best])
                 return DwaResult(chosen, _poses(path), len(commands), 0)
@@ -469,6 +469,18 @@ class DwaPlanner:
             best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+    def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
+        """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""
+        if moving is None or not len(moving):
+            return False
+        cfg, field = self.config, self.distance_field
+        xs, ys, _ = rollout(pose, np.zeros((1, 3)), cfg.dt, cfg.steps)
+        discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
+        _, moving_first, _ = contact_times(
+            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+        )
+        return bool(np.isfinite(moving_first[0]))
 
     def _extra(self, commands: np.ndarray):
         """The default profile's facing term for the admissible ``commands``, weighted."""

@@ -215,6 +215,8 @@ class FusionController:
                 self.status = "arrived"
                 return _step(stop, self.status)
             return _step(braking_command(self.config.dwa, command), "driving", self.goal)
+        if self._turning and self.dwa.threatened(pose, moving):
+            self._turning = False  # a walker is coming: evading beats finishing the turn
         if self._turning:
             return self._turn(pose, command, now)
         if self._recovery is not None and now < self._recovery.until - 1e-9:
