@@ -69,7 +69,7 @@ class Episode:
             name=f"nav-{self.seed}",
             description=self.events,
             dt=0.1,
-            time_limit=round(40 + 4 * self.shortest),
+            time_limit=round(60 + 6 * self.shortest),
             sensing_radius=SENSING_RADIUS,
             grid=self.grid,
             agvs=(AgvSpec("agv", self.start, self.goal, 0.0, config),),
