@@ -462,7 +462,8 @@ class DwaPlanner:
             g = g + self.behaviour.route_weight * normalised(
                 on_route(xs[ok], ys[ok], segment, cfg.clearance_cap)
             )
-        if self.behaviour.steady_tolerance > 0:
+        standing = math.hypot(command[0], command[1]) < _EPS
+        if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
             change = jerk(commands[ok], command, command if previous is None else previous)
             best = ok[steady_choice(g, change, self.behaviour.steady_tolerance)]
         else:

@@ -52,6 +52,10 @@ VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
 
 
+CALM_WINDOWS = 3
+"""Progress windows without a stall after which the recoveries start again from the first."""
+
+
 @dataclass(frozen=True)
 class FusionConfig:
     """Everything one AGV's planner needs; defaults are the paper's."""
@@ -124,6 +128,7 @@ class FusionController:
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
         self._recoveries_done = 0
+        self._last_stall = -math.inf  # sim time of the last stall
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
 
@@ -288,6 +293,7 @@ class FusionController:
             plan = self._plan_from(position)
             self._best_remaining, self._best_time = math.inf, now
             return plan
+        self._last_stall = now
         if self._recoveries_done >= len(RECOVERIES):
             self.status = "failed"
             self.failure = (
@@ -322,6 +328,7 @@ class FusionController:
         remaining = self.remaining(position)
         if remaining < self._best_remaining - self.config.progress_distance:
             self._best_remaining, self._best_time = remaining, now
-            self._recoveries_done = 0
+            if now - self._last_stall >= CALM_WINDOWS * self.config.progress_window:
+                self._recoveries_done = 0
             return False
         return now - self._best_time >= self.config.progress_window
