@@ -14,7 +14,15 @@ import pytest
 
 from fleet.inprocess import run_in_process
 from fleet.moving_obstacle import MovingObstacle
-from fleet.scenario import AgvSpec, Scenario, TemporaryObstacle, load_scenario, with_profile
+from fleet.scenario import (
+    AgvSpec,
+    Scenario,
+    ScenarioError,
+    TemporaryObstacle,
+    load_scenario,
+    parse_scenario,
+    with_profile,
+)
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
 from planner.fusion import FusionConfig
@@ -203,3 +211,14 @@ def test_a_blocked_corridor_ends_in_failed_with_the_reason_not_endless_driving()
     assert agv.status == "failed" and agv.collisions == 0
     assert "no progress after the recoveries" in agv.failure
     assert summary.sim_time < 100
+
+
+def test_the_planner_profile_is_a_scenario_key():
+    text = (
+        '[map]\ngrid = "....."\n[planner]\nprofile = "{}"\n'
+        '[[agvs]]\nname = "a"\nstart = [0.5, 0.5]\ngoal = [4.5, 0.5]\n'
+    )
+    assert parse_scenario(text.format("paper")).agvs[0].config.profile == "paper"
+    assert parse_scenario(text.format("default")).agvs[0].config.profile == "default"
+    with pytest.raises(ScenarioError, match="profile"):
+        parse_scenario(text.format("fast"))
