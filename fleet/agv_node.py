@@ -43,6 +43,8 @@ class AgvNode:
         """Load (or compile) every numba kernel this node uses, before the run starts."""
         warm_up()
         self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
+        walker = np.array([[*self.spec.start, 0.0, 0.0, 0.1]])  # the evasion kernel, too
+        self.controller.dwa.threatened((*self.spec.start, 0.0), walker)
 
     def on_tick(self, tick: Tick) -> NodeOutput:
         me = next(s for s in tick.agvs if s.name == self.name)
