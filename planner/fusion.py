@@ -121,7 +121,6 @@ class FusionController:
         self.behaviour = local_behaviour(self.config.profile, free_heading=self.config.free_heading)
         self.static_field = DistanceField.from_grid(grid)
         self.dwa = DwaPlanner(self.config.dwa, self.static_field, self.behaviour)
-        self.blockers: list[Point] = []  # where sensed obstacles blocked the route
         self._best_remaining = math.inf
         self._best_time = 0.0
         self._turning = False
@@ -282,8 +281,7 @@ class FusionController:
         )
         if blocker is None:
             return None
-        self.blockers.append(blocker)
-        plan = self._plan_from(position)
+        plan = self._plan_from(position)  # the blocking cells are in known_cells: marked
         self._best_remaining = self.remaining(position) if self.targets else math.inf
         return plan
 
