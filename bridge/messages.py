@@ -60,6 +60,7 @@ class AgvState:
     status: str = "driving"
     target: list[float] | None = None
     plan_time_ms: float = 0.0
+    failure: str = ""  # why, when status is "failed"
 
 
 @dataclass
@@ -82,6 +83,7 @@ class AgvCommand:
     target: list[float] | None = None
     plan_time_ms: float = 0.0
     start_heading: float | None = None
+    failure: str = ""  # why, when status is "failed"
 
 
 @dataclass

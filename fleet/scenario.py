@@ -232,6 +232,8 @@ def _parse_config(
     for key in planner:
         if key == "algorithm":
             fusion_args[key] = get_str(planner, key, planner_where, choices=VARIANTS)
+        elif key == "profile":
+            fusion_args[key] = get_str(planner, key, planner_where, choices=PROFILES)
         elif key in PLANNER_KEYS:
             field_name, scale = PLANNER_KEYS[key]
             dwa_args[field_name] = get_number(planner, key, planner_where, positive=True) * scale

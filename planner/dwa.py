@@ -31,7 +31,16 @@ One control cycle (``DwaPlanner.plan``):
    |(vx, vy)|. The first maximum wins.
 
 When nothing is admissible the command brakes every component towards zero
-as hard as the acceleration limits allow.
+as hard as the acceleration limits allow (the paper), or, with the default
+profile's ``LocalBehaviour.evade``, is the evasive fallback of
+``planner/evasion.py``.
+
+The default profile adds a term to Eq. (10), normalised like the others:
+``facing`` (pi - |atan2(vy, vx)|: the body faces its direction of travel) and
+``on_route`` (the trajectory stays near the global route's current segment);
+and it picks, among the samples scoring near the best, the one that changes
+the last cycle's acceleration least (``steady_choice``), so the chosen
+acceleration stops flipping every cycle.
 
 Beyond the paper, for arriving (at 0.2 m/s² an AGV at 2 m/s needs 10 m to
 stop, and a 3 s rollout's end lies past a nearby target, so plain DWA circles
@@ -51,6 +60,8 @@ import numba
 import numpy as np
 
 from planner.distance_field import DistanceField, lookup
+from planner.evasion import contact_times, evasive_index
+from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
 
 Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
@@ -284,11 +295,13 @@ def scores(
     clearance: np.ndarray,
     target_xy: tuple[float, float],
     reached: np.ndarray | None = None,
+    extra: np.ndarray | float = 0.0,
 ) -> np.ndarray:
     """Eq. (10) for admissible samples: alpha xhead + beta dist + gamma vel, each normalised.
 
     ``end`` is the trajectories' final (x, y, theta), ``clearance`` their minimum
-    clearance; ``reached`` marks trajectories that pass the target (full xhead).
+    clearance; ``reached`` marks trajectories that pass the target (full xhead);
+    ``extra`` is added (the default profile's terms, already weighted).
     """
     end_x, end_y, end_theta = end
     bearing = np.arctan2(target_xy[1] - end_y, target_xy[0] - end_x)
@@ -305,15 +318,69 @@ def scores(
         config.alpha * normalised(xhead)
         + config.beta * normalised(dist)
         + config.gamma * normalised(vel)
+        + extra
     )
+
+
+def facing(commands: np.ndarray) -> np.ndarray:
+    """pi - the angle between the body heading and the travel direction (pi when standing)."""
+    moving = np.hypot(commands[:, 0], commands[:, 1]) > _EPS
+    return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
+
+
+def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
+    """cap - the largest distance of each trajectory (N, K) from the route ``segment``
+    (capped at ``cap``): trajectories that stay on the global route score highest, so
+    the AGV lines up with a narrow passage the route goes through before it gets there."""
+    (ax, ay), (bx, by) = segment
+    dx, dy = bx - ax, by - ay
+    length2 = dx * dx + dy * dy
+    t = np.zeros_like(xs) if length2 < _EPS else ((xs - ax) * dx + (ys - ay) * dy) / length2
+    t = np.clip(t, 0.0, 1.0)
+    off = np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
+    return cap - np.minimum(off, cap)
+
+
+def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarray:
+    """(N,) how much each sample changes the last cycle's acceleration, in m/s per period.
+
+    Linear axes: |(sample - command) - (command - previous)|; omega adds the
+    same change times the speed, since a turn rate change of dw changes the
+    world-frame velocity by speed x dw.
+    """
+    keep = 2.0 * np.asarray(command) - np.asarray(previous)
+    speed = math.hypot(command[0], command[1])
+    return np.hypot(commands[:, 0] - keep[0], commands[:, 1] - keep[1]) + speed * np.abs(
+        commands[:, 2] - keep[2]
+    )
+
+
+def steady_choice(score: np.ndarray, change: np.ndarray, tolerance: float) -> int:
+    """The sample of least ``change`` among those scoring within ``tolerance`` of the best.
+
+    ``tolerance`` is a fraction of the scores' spread. The normalised scores
+    of neighbouring samples differ by little, so the plain argmax hops
+    between them every cycle and the acceleration flips; preferring the
+    steadiest near-best sample keeps the acceleration unless a clearly
+    better command exists.
+    """
+    top = float(score.max())
+    near = np.flatnonzero(score >= top - tolerance * (top - float(score.min())))
+    return int(near[np.lexsort((-score[near], change[near]))[0]])
 
 
 class DwaPlanner:
     """DWA over a static DistanceField (assignable: temporary obstacles become known)."""
 
-    def __init__(self, config: DwaConfig, distance_field: DistanceField):
+    def __init__(
+        self,
+        config: DwaConfig,
+        distance_field: DistanceField,
+        behaviour: LocalBehaviour = PAPER_BEHAVIOUR,
+    ):
         self.config = config
         self.distance_field = distance_field
+        self.behaviour = behaviour
 
     def plan(
         self,
@@ -324,13 +391,20 @@ class DwaPlanner:
         *,
         reach: float = 0.0,
         stop: bool = False,
+        previous: Command | None = None,
+        approach: bool = False,
+        segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
     ) -> DwaResult:
         """One control cycle from ``pose`` with current ``command`` towards the local target.
 
         ``moving``: (M, 5) discs [x, y, vx, vy, radius] in the world frame (other
         AGVs, moving obstacles), or None. ``reach``: a trajectory within this
         distance of the target scores full xhead. ``stop``: brake to arrive at
-        the target at rest (the final goal).
+        the target at rest (the final goal). ``previous``: the command of the
+        cycle before (for the steadiness term; None: the current one).
+        ``approach``: the final approach, where the dist term is replaced by
+        nearness to the target (goals in docks and pockets have little clearance).
+        ``segment``: the global route's segment to the target, for the ``on_route`` term.
         """
         cfg = self.config
         field = self.distance_field
@@ -354,6 +428,14 @@ class DwaPlanner:
             mask &= speed <= limit + _EPS
         ok = np.flatnonzero(mask)
         if ok.size == 0:
+            if self.behaviour.evade:
+                times = contact_times(
+                    xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+                )
+                best = evasive_index(*times)
+                chosen = tuple(float(v) for v in commands[best])
+                path = (xs[best], ys[best], thetas[best])
+                return DwaResult(chosen, _poses(path), len(commands), 0)
             brake = braking_command(cfg, command)
             path = rollout(pose, np.array([brake]), cfg.dt, cfg.steps)[:, 0, :]
             return DwaResult(brake, _poses(path), len(commands), 0)
@@ -362,10 +444,49 @@ class DwaPlanner:
         if reach > 0:
             gap2 = (xs[ok] - target_xy[0]) ** 2 + (ys[ok] - target_xy[1]) ** 2
             reached = gap2.min(axis=1) <= reach * reach
-        g = scores(cfg, commands[ok], end, clearance[ok], target_xy, reached)
-        best = ok[int(np.argmax(g))]
+        room = clearance[ok]
+        if approach:  # nearness to the target in place of clearance
+            room = cfg.clearance_cap - np.minimum(
+                np.hypot(end[0] - target_xy[0], end[1] - target_xy[1]), cfg.clearance_cap
+            )
+        g = scores(
+            cfg,
+            commands[ok],
+            end,
+            room,
+            target_xy,
+            reached,
+            self._extra(commands[ok]),
+        )
+        if segment is not None and self.behaviour.route_weight > 0:
+            g = g + self.behaviour.route_weight * normalised(
+                on_route(xs[ok], ys[ok], segment, cfg.clearance_cap)
+            )
+        standing = math.hypot(command[0], command[1]) < _EPS
+        if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
+            change = jerk(commands[ok], command, command if previous is None else previous)
+            best = ok[steady_choice(g, change, self.behaviour.steady_tolerance)]
+        else:
+            best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+    def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
+        """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""
+        if moving is None or not len(moving):
+            return False
+        cfg, field = self.config, self.distance_field
+        xs, ys, _ = rollout(pose, np.zeros((1, 3)), cfg.dt, cfg.steps)
+        discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
+        _, moving_first, _ = contact_times(
+            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+        )
+        return bool(np.isfinite(moving_first[0]))
+
+    def _extra(self, commands: np.ndarray):
+        """The default profile's facing term for the admissible ``commands``, weighted."""
+        weight = self.behaviour.face_travel_weight
+        return weight * normalised(facing(commands)) if weight > 0 else 0.0
 
 
 def _poses(path) -> np.ndarray:

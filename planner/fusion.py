@@ -20,6 +20,13 @@ controller replans globally on the static map plus the temporary obstacles
 seen so far. A replan that finds no path means the goal is unreachable on
 what the AGV knows: status ``failed``. A cycle in which DWA has no admissible
 trajectory (boxed in, braking) reports ``blocked``.
+
+The default profile (``planner/local_behaviour.py``) adds: the initial turn
+driven within the omega and alpha limits; every cycle in which new obstacles
+were sensed, a check of the remaining route against them and an immediate
+replan when they block it; a final approach scored by nearness to the goal;
+arrival only when stopped inside the tolerance; bounded recoveries
+(``planner/recovery.py``) and then ``failed`` with the reason.
 """
 
 from __future__ import annotations
@@ -27,22 +34,30 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner
+from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point
+from planner.local_behaviour import local_behaviour
 from planner.profiles import DEFAULT, check_profile
+from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
+from planner.route_check import blocked_point
+from planner.turning import turn_command
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
 GLOBAL_ALGORITHM = _GLOBAL_ALGORITHM
 """The global A* variant each planner variant plans with (``dwa`` has none)."""
+
+
+CALM_WINDOWS = 3
+"""Progress windows without a stall after which the recoveries start again from the first."""
 
 
 @dataclass(frozen=True)
@@ -57,6 +72,8 @@ class FusionConfig:
     goal_tolerance: float = 0.2
     progress_window: float = 5.0
     progress_distance: float = 0.3
+    approach_distance: float = 3.0  # m: the final approach starts this close to the goal
+    free_heading: bool = False  # default profile: keep the paper's free heading
 
     def __post_init__(self) -> None:
         check_profile(self.profile)
@@ -64,7 +81,11 @@ class FusionConfig:
             raise ValueError(
                 f"unknown planner algorithm {self.algorithm!r}: choose one of {', '.join(VARIANTS)}"
             )
-        for name in ("safety_distance", "switch_distance", "goal_tolerance", "progress_window"):
+        positive = (
+            "safety_distance", "switch_distance", "goal_tolerance", "progress_window",
+            "approach_distance",
+        )  # fmt: skip
+        for name in positive:
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
         self.clearance  # noqa: B018 - a safety distance below the radius is an error
@@ -87,6 +108,14 @@ class ControlStep:
     plan_time_s: float
 
 
+def _step(command, status, target=None, trajectory=None, plan=None) -> ControlStep:
+    empty = np.empty((0, 3))
+    command = tuple(float(v) for v in command)
+    return ControlStep(
+        command, status, target, empty if trajectory is None else trajectory, plan, 0.0
+    )
+
+
 class FusionController:
     """One AGV's planner: global plan + DWA, stepped once per control period."""
 
@@ -99,7 +128,9 @@ class FusionController:
         self.target_index = 0
         self.status = "driving"
         self.failure = ""
-        self.dwa = DwaPlanner(self.config.dwa, DistanceField.from_grid(grid))
+        self.behaviour = local_behaviour(self.config.profile, free_heading=self.config.free_heading)
+        self.static_field = DistanceField.from_grid(grid)
+        self.dwa = DwaPlanner(self.config.dwa, self.static_field, self.behaviour)
         # default profile: the map's costmap for this AGV (shared through the map's cache),
         # plus the temporary obstacles seen so far
         self.costmap = None
@@ -107,6 +138,13 @@ class FusionController:
             self.costmap = Costmap.for_grid(grid, self.config.clearance)
         self._best_remaining = math.inf
         self._best_time = 0.0
+        self._turning = False
+        self._previous = (0.0, 0.0, 0.0)
+        self._recovery: Recovery | None = None
+        self._recoveries_done = 0
+        self._last_stall = -math.inf  # sim time of the last stall
+        self._planned_at = goal  # where the AGV was when it last planned
+        self._route_stale = False  # new obstacles sensed since the route was last checked
 
     # --- planning -----------------------------------------------------------------
     def start(
@@ -115,14 +153,18 @@ class FusionController:
         """Plan from the start pose; returns the (possibly turned) start pose and the plan."""
         plan = self._plan_from((pose[0], pose[1]))
         if self.config.algorithm == "fusion" and plan is not None and plan.found:
-            first = self.targets[0]
-            pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
+            if self.behaviour.recorded_turn:
+                self._turning = True  # driven by ``step`` within the limits
+            else:
+                first = self.targets[0]
+                pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
         return pose, plan
 
     def _plan_from(self, position: Point) -> PlanResult | None:
         if self.config.algorithm == "dwa":
             self.targets = [self.goal]
             self.target_index = 0
+            self._planned_at = position
             return None
         if self.costmap is not None:
             known = self.costmap.grid
@@ -148,6 +190,7 @@ class FusionController:
             return plan
         # the start cell's centre is not a target: the AGV is already there; for
         # astar-dwa the key nodes are the traditional path's turning points
+        self._planned_at = position
         self.targets = list(plan.key_nodes[1:]) or [self.goal]
         self.targets[-1] = self.goal
         self.target_index = 0
@@ -162,6 +205,7 @@ class FusionController:
         if self.costmap is not None:
             self.costmap = self.costmap.with_blocked(new)
         self.dwa.distance_field = DistanceField.from_grid(self.grid.with_blocked(self.known_cells))
+        self._route_stale = True
         return True
 
     # --- control ------------------------------------------------------------------
@@ -174,33 +218,109 @@ class FusionController:
     ) -> ControlStep:
         """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]."""
         t0 = time.perf_counter()
+        out = self._step(pose, command, now, moving)
+        self._previous = command
+        return replace(out, plan_time_s=time.perf_counter() - t0)
+
+    def _step(self, pose, command, now, moving) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
         if self.status in ("arrived", "failed"):
-            return ControlStep(stop, self.status, None, np.empty((0, 3)), None, 0.0)
+            return _step(stop, self.status)
         position = (pose[0], pose[1])
         if math.dist(position, self.goal) <= self.config.goal_tolerance:
-            self.status = "arrived"
-            return ControlStep(stop, self.status, None, np.empty((0, 3)), None, 0.0)
-        plan = None
-        if self._stalled(position, now) and self.config.algorithm != "dwa":
-            plan = self._plan_from(position)
-            self._best_remaining, self._best_time = math.inf, now
+            if not self.behaviour.smooth_arrival or is_stopped(command):
+                self.status = "arrived"
+                return _step(stop, self.status)
+            return _step(braking_command(self.config.dwa, command), "driving", self.goal)
+        if self._turning and self.dwa.threatened(pose, moving):
+            self._turning = False  # a walker is coming: evading beats finishing the turn
+        if self._turning:
+            return self._turn(pose, command, now)
+        if self._recovery is not None and now < self._recovery.until - 1e-9:
+            kind = self._recovery.kind
+            cmd = recovery_command(kind, self.config.dwa, self.dwa.distance_field, pose, command)
+            return _step(cmd, "blocked", self.targets[self.target_index])
+        self._recovery = None
+        plan = self._check_route(position) if self.behaviour.route_check else None
+        if self.status == "failed":
+            return _step(stop, self.status, plan=plan)
+        if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
+            plan = self._on_stall(position, now)
             if self.status == "failed":
-                return ControlStep(stop, self.status, None, np.empty((0, 3)), plan, 0.0)
+                return _step(stop, self.status, plan=plan)
+            if self._recovery is not None:
+                return self._step(pose, command, now, moving)
         self._advance_target(position)
         target = self.targets[self.target_index]
         final = self.target_index == len(self.targets) - 1
         reach = self.config.goal_tolerance if final else self.config.switch_distance
-        result = self.dwa.plan(pose, command, target, moving, reach=reach, stop=final)
-        self.status = "blocked" if not result.admissible else "driving"
-        return ControlStep(
-            tuple(float(v) for v in result.command),
-            self.status,
-            target,
-            result.trajectory,
-            plan,
-            time.perf_counter() - t0,
+        approach = (
+            self.behaviour.final_approach
+            and final
+            and math.dist(position, target) <= self.config.approach_distance
         )
+        result = self.dwa.plan(
+            pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
+            approach=approach, segment=(self._segment_start(), target),
+        )  # fmt: skip
+        self.status = "blocked" if not result.admissible else "driving"
+        return _step(result.command, self.status, target, result.trajectory, plan)
+
+    def _segment_start(self) -> Point:
+        """Where the route's current segment starts: the previous key node, or where the
+        AGV was when it planned."""
+        return self.targets[self.target_index - 1] if self.target_index else self._planned_at
+
+    def _turn(self, pose, command, now) -> ControlStep:
+        """The initial turn towards the first key node, as motion within the limits."""
+        first = self.targets[0]
+        bearing = math.atan2(first[1] - pose[1], first[0] - pose[0])
+        error = float(wrap_angle(bearing - pose[2]))
+        cmd = turn_command(self.config.dwa, error, command)
+        if cmd is None:
+            self._turning = False
+            cmd = braking_command(self.config.dwa, command)
+        self._best_time = now  # turning on the spot is progress for the progress checker
+        return _step(cmd, "driving", first)
+
+    def _check_route(self, position: Point) -> PlanResult | None:
+        """Replan at once when newly sensed obstacles block the remaining route."""
+        if not self._route_stale or self.config.algorithm == "dwa":
+            return None
+        self._route_stale = False
+        route = [position, *self.targets[self.target_index :]]
+        blocker = blocked_point(
+            self.dwa.distance_field, route, self.config.dwa.radius, self.static_field
+        )
+        if blocker is None:
+            return None
+        plan = self._plan_from(position)  # the blocking cells are in known_cells: marked
+        self._best_remaining = self.remaining(position) if self.targets else math.inf
+        return plan
+
+    def _on_stall(self, position: Point, now: float) -> PlanResult | None:
+        """No progress for ``progress_window``: replan (paper) or the next recovery (default)."""
+        if not self.behaviour.recover:
+            plan = self._plan_from(position)
+            self._best_remaining, self._best_time = math.inf, now
+            return plan
+        self._last_stall = now
+        if self._recoveries_done >= len(RECOVERIES):
+            self.status = "failed"
+            self.failure = (
+                f"no progress after the recoveries {', '.join(RECOVERIES)} "
+                f"({self.remaining(position):.1f} m of route left)"
+            )
+            return None
+        kind = RECOVERIES[self._recoveries_done]
+        self._recoveries_done += 1
+        plan = self._plan_from(position) if kind == "replan" else None
+        if self.targets:
+            self._best_remaining = self.remaining(position)
+        self._best_time = now + DURATION_S[kind]
+        if DURATION_S[kind] > 0:
+            self._recovery = Recovery(kind, now + DURATION_S[kind])
+        return plan
 
     def _advance_target(self, position: Point) -> None:
         last = len(self.targets) - 1
@@ -219,5 +339,7 @@ class FusionController:
         remaining = self.remaining(position)
         if remaining < self._best_remaining - self.config.progress_distance:
             self._best_remaining, self._best_time = remaining, now
+            if now - self._last_stall >= CALM_WINDOWS * self.config.progress_window:
+                self._recoveries_done = 0
             return False
         return now - self._best_time >= self.config.progress_window

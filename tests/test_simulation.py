@@ -60,10 +60,11 @@ def test_the_same_scenario_gives_the_same_run():
     assert first.to_json()["agvs"] == second.to_json()["agvs"]
 
 
-def test_fusion_turns_the_start_heading_to_the_first_key_node():
+def test_paper_fusion_turns_the_start_heading_to_the_first_key_node():
     grid = parse_text_grid("\n".join(["." * 10] * 10))
     for algorithm, expected in (("fusion", math.atan2(8.0, 3.0)), ("astar-dwa", 0.0)):
-        ctl = FusionController(grid, (3.5, 8.5), FusionConfig(algorithm=algorithm))
+        config = FusionConfig(algorithm=algorithm, profile="paper")
+        ctl = FusionController(grid, (3.5, 8.5), config)
         pose, plan = ctl.start((0.5, 0.5, 0.0))
         assert pose[2] == pytest.approx(expected), algorithm
         assert plan.found

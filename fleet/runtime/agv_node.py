@@ -55,6 +55,8 @@ class AgvNode:
         """Load (or compile) every numba kernel this node uses, before the run starts."""
         warm_up()
         self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
+        walker = np.array([[*self.spec.start, 0.0, 0.0, 0.1]])  # the evasion kernel, too
+        self.controller.dwa.threatened((*self.spec.start, 0.0), walker)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""
@@ -79,6 +81,7 @@ class AgvNode:
         command = self._command(tick, step.command, step.status, step.target)
         command.plan_time_ms = step.plan_time_s * 1e3
         command.start_heading = start_heading
+        command.failure = self.controller.failure if step.status == FAILED else ""
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(

@@ -135,10 +135,10 @@ class World:
         record.distance += math.hypot(x - old.x, y - old.y)
         self.states[name] = AgvState(
             name, self.tick, x, y, theta, *velocity, old.radius, status,
-            command.target, command.plan_time_ms,
+            command.target, command.plan_time_ms, command.failure if status == FAILED else "",
         )  # fmt: skip
         if status in FINISHED and record.status not in FINISHED:
-            self._finish(name, status, status)
+            self._finish(name, status, command.failure or status)
 
     def _refuse(self, name: str, what: str) -> None:
         """A report the world does not believe: counted, and an event the first time."""

@@ -1,0 +1,163 @@
+"""Single-AGV navigation episodes: the local planner of each variant side by side.
+
+``python benchmarks/nav_bench.py [--episodes 100] [--workers 2]`` (from the
+repository root) generates the seeded episodes of ``nav_episodes.py`` (each
+has a way the body fits through) and runs each in process with ``fusion``
+(default profile), ``fusion`` (paper profile), ``astar-dwa`` and ``dwa``
+(both, as the paper's baselines, with the paper profile). Per variant:
+success (arrived, no collision), episodes with a collision, median distance
+driven / shortest path the body fits through (successful episodes), median
+arrival time, median RMS jerk per vehicle (world-frame, over the drive, as
+``recordings.analysis`` defines it) and the wall time. Then the default
+fusion's targets: 100 % success, 0 collisions, median driven/shortest <=
+1.15, RMS jerk <= 0.6 m/s³ at Table-1 limits; a MISS never fails the run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing
+import statistics
+import sys
+import time
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
+from benchmarks.nav_episodes import Episode, episodes
+from fleet.runtime.inprocess import run_in_process
+from recordings.analysis import world_velocity
+
+VARIANTS = (
+    ("fusion (default)", "fusion", "default"),
+    ("fusion (paper)", "fusion", "paper"),
+    ("astar-dwa (paper)", "astar-dwa", "paper"),
+    ("dwa (paper)", "dwa", "paper"),
+)
+
+
+def rms_jerk(states, dt: float) -> float:
+    """RMS of the world-frame jerk over the drive (up to arrival or failure)."""
+    end = next((i for i, s in enumerate(states) if s.status in ("arrived", "failed")), len(states))
+    drive = states[: end + 1]
+    if len(drive) < 3:
+        return 0.0
+    col = {k: np.array([getattr(s, k) for s in drive]) for k in ("theta", "vx", "vy", "omega")}
+    velocity = world_velocity(col["theta"], col["vx"], col["vy"], col["omega"], dt)
+    jerk = np.diff(velocity, n=2, axis=0) / dt**2
+    return float(np.sqrt((jerk**2).sum(axis=1).mean()))
+
+
+def run_one(job: tuple[Episode, str, str, str]) -> dict:
+    episode, label, algorithm, profile = job
+    scenario = episode.scenario(algorithm, profile)
+    states = []
+    summary = run_in_process(
+        scenario, lambda key, msg: states.extend(msg.agvs) if key == "world/tick" else None
+    )
+    agv = summary.agvs[0]
+    return {
+        "seed": episode.seed,
+        "vehicle": episode.vehicle,
+        "kind": f"{episode.goal_kind}:{episode.events}",
+        "variant": label,
+        "status": agv.status,
+        "failure": agv.failure,
+        "collisions": agv.collisions,
+        "ratio": agv.distance / episode.shortest,
+        "arrival": agv.arrival_time,
+        "jerk": rms_jerk(states, scenario.dt),
+        "wall": summary.wall_time,
+    }
+
+
+def _median(values) -> str:
+    values = list(values)
+    return f"{statistics.median(values):.2f}" if values else "-"
+
+
+def table(results: list[dict], count: int) -> str:
+    by = defaultdict(list)
+    for r in results:
+        by[r["variant"]].append(r)
+    header = ("variant", "success", "collided", "driven/shortest", "arrival s",
+              "jerk T1", "jerk real", "wall s")  # fmt: skip
+    rows = [header]
+    for label, _, _ in VARIANTS:
+        rs = by[label]
+        ok = [r for r in rs if r["status"] == "arrived" and r["collisions"] == 0]
+        rows.append(
+            (
+                label,
+                f"{len(ok)}/{count}",
+                str(sum(r["collisions"] > 0 for r in rs)),
+                _median(r["ratio"] for r in ok),
+                _median(r["arrival"] for r in ok),
+                _median(r["jerk"] for r in ok if r["vehicle"] == "table1"),
+                _median(r["jerk"] for r in ok if r["vehicle"] == "realistic"),
+                f"{sum(r['wall'] for r in rs):.0f}",
+            )
+        )
+    widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
+    lines = ["  ".join(c.ljust(w) for c, w in zip(r, widths, strict=True)) for r in rows]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+def targets(results: list[dict], count: int) -> list[str]:
+    rs = [r for r in results if r["variant"] == VARIANTS[0][0]]
+    ok = [r for r in rs if r["status"] == "arrived" and r["collisions"] == 0]
+    ratio = statistics.median(r["ratio"] for r in ok) if ok else float("inf")
+    jerks = [r["jerk"] for r in ok if r["vehicle"] == "table1"]
+    jerk = statistics.median(jerks) if jerks else float("inf")
+    collided = sum(r["collisions"] > 0 for r in rs)
+    checks = (
+        (f"success {len(ok)}/{count} = 100 %", len(ok) == count),
+        (f"collisions {collided} = 0", collided == 0),
+        (f"median driven/shortest {ratio:.2f} <= 1.15", ratio <= 1.15),
+        (f"median RMS jerk at Table-1 limits {jerk:.2f} <= 0.6 m/s³", jerk <= 0.6),
+    )
+    return [f"{'PASS' if good else 'MISS'} fusion (default): {text}" for text, good in checks]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--episodes", type=int, default=100)
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--variants", default="all", help="'all' or a comma list of labels")
+    args = parser.parse_args()
+    chosen = [v for v in VARIANTS if args.variants == "all" or v[0] in args.variants.split(",")]
+    eps = episodes(args.episodes)
+    jobs = [(e, *v) for e in eps for v in chosen]
+    t0 = time.perf_counter()
+    with multiprocessing.get_context("spawn").Pool(max(1, min(args.workers, 2))) as pool:
+        results = pool.map(run_one, jobs, chunksize=4)
+    kinds = defaultdict(int)
+    for e in eps:
+        kinds[e.goal_kind] += 1
+    print(
+        f"{len(eps)} episodes (seeds {eps[0].seed}-{eps[-1].seed}; goals: "
+        + ", ".join(f"{k} {n}" for k, n in sorted(kinds.items()))
+        + f"; {sum('crossing' in e.events for e in eps)} crossing walkers, "
+        f"{sum('head-on' in e.events for e in eps)} head-on, "
+        f"{sum('wall-early' in e.events for e in eps)} early and "
+        f"{sum('wall-late' in e.events for e in eps)} late walls), "
+        f"run in {time.perf_counter() - t0:.0f} s"
+    )
+    print(table(results, len(eps)))
+    for line in targets(results, len(eps)):
+        print(line)
+    failures = [r for r in results if r["variant"] == VARIANTS[0][0]]
+    failures = [r for r in failures if r["status"] != "arrived" or r["collisions"]]
+    for r in failures:
+        print(
+            f"  default fusion seed {r['seed']} ({r['vehicle']}, {r['kind']}): {r['status']}"
+            f"{' ' + r['failure'] if r['failure'] else ''}, {r['collisions']} collision(s)"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,57 @@
+"""The evasive fallback: when no sample is admissible, delay contact as long as possible.
+
+The paper brakes when nothing is admissible (Guo et al. 2023, section 3). A
+standing AGV is still in a walker's way, so braking is often exactly what
+gets it hit. Instead every sample of the window is ranked by its time to
+contact with the static map (later is better: a wall is certain, a
+prediction is not), then with the moving discs predicted at constant
+velocity (later is better), then by its lowest clearance over the whole
+horizon (higher is better): the AGV steps aside, backs away or brakes,
+whichever keeps it out of contact longest without driving into a wall.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from planner.distance_field import lookup
+
+
+@numba.njit(cache=True)
+def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius):
+    """(N,) times of each trajectory's first contact with the static map and with a moving
+    disc (inf: none), (N,) its lowest clearance.
+
+    ``xs``, ``ys`` (N, K) as in ``dwa.min_clearance``; moving discs (M, 5) rows
+    [x, y, vx, vy, r] at constant velocity. Unlike ``min_clearance`` the whole
+    horizon is evaluated, so the lowest clearance ranks trajectories in contact.
+    """
+    n_traj, n_steps = xs.shape
+    static_first = np.full(n_traj, np.inf)
+    moving_first = np.full(n_traj, np.inf)
+    lowest = np.empty(n_traj)
+    for n in range(n_traj):
+        worst = np.inf
+        for k in range(n_steps):
+            x, y, t = xs[n, k], ys[n, k], (k + 1) * dt
+            c = lookup(samples, inv_spacing, x, y) - radius
+            if c <= 0.0 and static_first[n] == np.inf:
+                static_first[n] = t
+            for m in range(moving.shape[0]):
+                dx = x - (moving[m, 0] + moving[m, 2] * t)
+                dy = y - (moving[m, 1] + moving[m, 3] * t)
+                gap = math.sqrt(dx * dx + dy * dy) - moving[m, 4] - radius
+                if gap <= 0.0 and moving_first[n] == np.inf:
+                    moving_first[n] = t
+                c = min(c, gap)
+            worst = min(worst, c)
+        lowest[n] = worst
+    return static_first, moving_first, lowest
+
+
+def evasive_index(static_first: np.ndarray, moving_first: np.ndarray, lowest: np.ndarray) -> int:
+    """The sample that meets a wall last, then a moving disc last, then keeps most clearance."""
+    return int(np.lexsort((-lowest, -moving_first, -static_first))[0])
