@@ -54,9 +54,12 @@ def _draw_map(ax, grid: GridMap | None) -> None:
     ax.tick_params(labelsize="x-small")
 
 
-def plans_figure(maps: Sequence[MapPlans], titles: Sequence[str], path: Path, columns=5) -> Path:
-    """Each map with the traditional (dashed red) and improved (solid blue) key-node paths."""
-    figure, axes = _panels(len(maps), columns)
+def plans_figure(
+    maps: Sequence[MapPlans], titles: Sequence[str], path: Path, columns=5, size: float = 3.0
+) -> Path:
+    """Each map with the traditional (dashed red) and improved (solid blue) key-node paths
+    (``size``: inches per panel)."""
+    figure, axes = _panels(len(maps), columns, size)
     for ax, plans, title in zip(axes, maps, titles, strict=True):
         _draw_map(ax, plans.grid)
         for algorithm, plan in plans.plans.items():

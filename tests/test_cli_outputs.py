@@ -8,13 +8,16 @@ import csv
 import io
 import subprocess
 import sys
+from importlib.metadata import version
 
 import numpy as np
 import pytest
 from matplotlib.image import imread
 
 from fleet.builtin import builtin_scenarios
+from fleet.cli.main import main
 from fleet.paper.experiments import record_plans
+from fleet.scenario import load_scenario
 from planner.grid_map import GridMap
 from recordings.analysis import analyze
 from recordings.reader import open_recording
@@ -115,3 +118,30 @@ def test_info_on_a_plan_only_recording_says_what_it_holds(tmp_path):
     assert done.returncode == 0, done.stderr
     ended = [line for line in done.stdout.splitlines() if line.startswith("Ended:")]
     assert ended == ["Ended:      plans only, no simulation: traditional found, improved found"]
+
+
+# --- version, built-in scenarios, plan pictures ---------------------------------------------
+def test_version_names_the_installed_package(capsys):
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0
+    assert capsys.readouterr().out.strip() == f"agv-fleet {version('agv-fleet')}"
+
+
+def test_scenarios_show_prints_a_builtin_that_loads_as_it_is(tmp_path, capsys):
+    assert main(["scenarios", "show", "corridor"]) == 0
+    copy = tmp_path / "mine.toml"
+    copy.write_text(capsys.readouterr().out)
+    assert load_scenario(copy).agvs == load_scenario("corridor").agvs
+    assert main(["scenarios", "show", "nowhere"]) == 2
+    assert "no built-in scenario 'nowhere'" in capsys.readouterr().err
+
+
+def test_plan_plot_draws_the_map_and_both_routes(public_data, tmp_path):
+    out = tmp_path / "plan.png"
+    depot = str(public_data / "nav2" / "depot.yaml")
+    assert main(["plan", depot, "--start", "2", "2", "--goal", "28", "12", "--plot", str(out)]) == 0
+    pixels = imread(out)[..., :3]
+    red = (pixels[..., 0] > 0.8) & (pixels[..., 1] < 0.3) & (pixels[..., 2] < 0.3)
+    blue = (pixels[..., 2] > 0.6) & (pixels[..., 0] < 0.3)
+    assert red.sum() > 100 and blue.sum() > 100  # traditional dashed red, improved blue

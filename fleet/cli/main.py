@@ -10,9 +10,10 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from importlib.metadata import version
 
 from fleet import exit_codes
-from fleet.cli import nodes, paper, plan, recordings, replay, run
+from fleet.cli import nodes, paper, plan, recordings, replay, run, scenarios
 from planner.errors import AgvFleetError
 
 
@@ -25,9 +26,11 @@ def build_parser() -> argparse.ArgumentParser:
             "3 environment or bus failure, 130 interrupted"
         ),
     )
+    parser.add_argument("--version", action="version", version=f"agv-fleet {version('agv-fleet')}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     plan.add_parser(sub)
     run.add_parsers(sub)
+    scenarios.add_parsers(sub)
     nodes.add_parsers(sub)
     recordings.add_parsers(sub)
     replay.add_parsers(sub)

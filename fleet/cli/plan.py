@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+from pathlib import Path
 
 from fleet import exit_codes
 from fleet.builtin import bundled_maps, resolve_map
@@ -58,6 +60,9 @@ def add_parser(sub) -> None:
         help="unknown cells of a ROS map: obstacles (default) or free",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--plot", metavar="FILE.png", help="also draw the map and each plan's key-node route"
+    )
     p.set_defaults(handler=run)
 
 
@@ -93,7 +98,20 @@ def run(args: argparse.Namespace) -> int:
             f"origin ({x0:g}, {y0:g}); profile {args.profile}"
         )
         print(plans_table(results))
+    if args.plot:
+        _plot(args, grid, results)
     return exit_codes.OK if all(r.found for r in results) else exit_codes.NOT_SUCCEEDED
+
+
+def _plot(args: argparse.Namespace, grid, results: list[PlanResult]) -> None:
+    # imported here: matplotlib takes ~0.2 s to load, and only --plot needs it
+    from recordings.paper_plots import plans_figure
+    from recordings.plan_metrics import MapPlans
+
+    plans = MapPlans(str(args.map), grid.name, grid, {}, {r.algorithm: r for r in results})
+    title = f"{grid.name}: profile {args.profile}"
+    plans_figure([plans], [title], Path(args.plot), columns=1, size=8.0)
+    print(f"agv-fleet plan: drew {args.plot}", file=sys.stderr)
 
 
 def plans_json(map_name: str, start, goal, results: list[PlanResult]) -> dict:

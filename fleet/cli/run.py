@@ -10,14 +10,13 @@ from contextlib import ExitStack
 from pathlib import Path
 
 from fleet import exit_codes
-from fleet.builtin import builtin_scenarios
 from fleet.cli.arguments import UsageError, positive_float
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.runtime.progress import Progress
 from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
-from fleet.scenario import ScenarioError, load_scenario, with_algorithm, with_profile
+from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
 from planner.profiles import PROFILES
 from recordings.rerun_view import LiveView, RerunError
@@ -102,10 +101,6 @@ def add_parsers(sub) -> None:
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
-
-    s = sub.add_parser("scenarios", help="list the built-in scenarios")
-    s.add_argument("--json", action="store_true")
-    s.set_defaults(handler=list_scenarios)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -197,21 +192,3 @@ def _run_in_process(scenario, record_path, args, progress, view):
         "profile": args.profile or "scenario's",
     }
     return run_recorded(scenario, record_path, facts, view, progress)
-
-
-def list_scenarios(args: argparse.Namespace) -> int:
-    rows = []
-    for name, path in builtin_scenarios().items():
-        try:
-            sc = load_scenario(path)
-            rows.append((name, len(sc.agvs), sc.description))
-        except ScenarioError as err:
-            rows.append((name, 0, f"(broken: {err})"))
-    if args.json:
-        print(json.dumps([{"name": n, "agvs": k, "description": d} for n, k, d in rows]))
-    else:
-        width = max((len(n) for n, _, _ in rows), default=0)
-        for name, count, description in rows:
-            agvs = f"{count} AGV" + ("s" if count != 1 else "")
-            print(f"{name.ljust(width)}  {agvs:>7}  {description}")
-    return exit_codes.OK
