@@ -158,6 +158,20 @@ def table3(r: PaperResults, figures: Path, claims: Claims) -> str:
     )
 
 
+def default_profile(r: PaperResults, figures: Path, claims: Claims) -> str:
+    """Tables 2 and 3 on the same maps planned with the default profile. Their rows are
+    not claims of the paper's, so they stay out of the summary (a claims list of their own)."""
+    prose = Prose("default-profile")
+    own = Claims()
+    ours = "ours, default profile"
+    grid20 = [m for m in r.grid20_default if m.found]
+    random50 = [m for m in r.random50_default if m.found]
+    return prose(
+        table2=plan_comparison(TABLE2, grid20, prose("label2"), own, False, ours),
+        table3=plan_comparison(TABLE3, random50, prose("label3"), own, True, ours),
+    )
+
+
 def _count(maps: list[MapPlans], key: str, better) -> int:
     """On how many maps the improved A* is ``better(improved, traditional)`` in ``key``."""
     return sum(better(metric(m, "improved", key), metric(m, "traditional", key)) for m in maps)

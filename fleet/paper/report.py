@@ -15,7 +15,7 @@ from fleet.paper import markdown as md
 from fleet.paper.claims import Claims
 from fleet.paper.dynamic_sections import smoothness, table4
 from fleet.paper.experiments import PaperResults
-from fleet.paper.plan_sections import table2, table3
+from fleet.paper.plan_sections import default_profile, table2, table3
 from fleet.paper.prose import Prose
 from fleet.paper.published import CITATION, MOTION, TABLE4
 from fleet.paper.trap_sections import fig8, fig9
@@ -23,7 +23,7 @@ from fleet.paper.trap_sections import fig8, fig9
 REPORT_NAME = "paper-reproduction.md"
 # each builds its section's Markdown and adds its claims; in the report's order
 Section = Callable[[PaperResults, Path, Claims], str]
-SECTIONS: tuple[Section, ...] = (table2, table3, fig8, fig9, table4, smoothness)
+SECTIONS: tuple[Section, ...] = (table2, table3, default_profile, fig8, fig9, table4, smoothness)
 
 
 def _paper_run_speed() -> dict[str, str]:
