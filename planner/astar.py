@@ -62,6 +62,9 @@ class SearchResult:
         return bool(self.cells)
 
 
+_NO_PENALTY = np.zeros((1, 1))  # the plain map's steps cost their length
+
+
 def search(
     grid: GridMap,
     start: Cell,
@@ -78,6 +81,7 @@ def search(
     t0 = time.perf_counter()
     path, expansions = _astar(
         blocked,
+        _NO_PENALTY,
         grid.prefix_sums,
         int(start[0]),
         int(start[1]),
@@ -85,6 +89,7 @@ def search(
         int(goal[1]),
         improved,
         corner_cutting,
+        False,
     )
     elapsed = time.perf_counter() - t0
     width = grid.width
@@ -104,7 +109,7 @@ def search_costmap(
             raise ValueError(f"{what} cell {cell} is outside the map")
     t0 = time.perf_counter()
     closed = costmap.passable(start, goal)
-    path, expansions = _astar_costmap(
+    path, expansions = _astar(
         closed,
         costmap.penalty,
         grid.prefix_sums,
@@ -113,6 +118,8 @@ def search_costmap(
         int(goal[0]),
         int(goal[1]),
         improved,
+        False,
+        True,
     )
     elapsed = time.perf_counter() - t0
     width = grid.width
@@ -176,7 +183,11 @@ def _heap_pop(heap, size):
 
 
 @numba.njit(cache=True)
-def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
+def _astar(blocked, penalty, prefix, sc, sr, gc, gr, improved, corner_cutting, weighted):
+    """The one A* kernel. ``blocked`` (uint8) is 1 where no step may enter: the map's
+    obstacles, or a costmap's lethal cells, which then also stand for obstacles in the
+    hybrid rule and the diagonal rule. ``weighted``: a step into cell n costs its length
+    times (1 + penalty[n]) (a costmap); otherwise its length (``penalty`` unused)."""
     height, width = blocked.shape
     n = height * width
     g = np.full(n, np.inf)
@@ -227,95 +238,7 @@ def _astar(blocked, prefix, sc, sr, gc, gr, improved, corner_cutting):
                 step = SQRT2
             else:
                 step = 1.0
-            ng = g_node + step
-            if ng >= g[nb]:
-                continue
-            g[nb] = ng
-            parent[nb] = node
-            h = math.sqrt(float((gc - cc) ** 2 + (gr - rr) ** 2))
-            if improved:
-                c0 = min(cc, gc)
-                c1 = max(cc, gc)
-                r0 = min(rr, gr)
-                r1 = max(rr, gr)
-                p = (
-                    prefix[r1 + 1, c1 + 1]
-                    - prefix[r0, c1 + 1]
-                    - prefix[r1 + 1, c0]
-                    + prefix[r0, c0]
-                )
-                h = math.exp(p / k) * h
-            heap, size = _heap_push(heap, size, ng + h, h, nb)
-
-    if state[goal] != 2:
-        return np.empty(0, np.int64), expansions
-    length = 1
-    node = goal
-    while node != start:
-        node = parent[node]
-        length += 1
-    path = np.empty(length, np.int64)
-    node = goal
-    for i in range(length - 1, -1, -1):
-        path[i] = node
-        node = parent[node]
-    return path, expansions
-
-
-@numba.njit(cache=True)
-def _astar_costmap(closed, penalty, prefix, sc, sr, gc, gr, improved):
-    """``_astar`` on a costmap: ``closed`` (uint8) is 1 where no step may enter (the
-    lethal cells) and is also the rule's obstacle test; a step into cell n costs its
-    length times (1 + penalty[n])."""
-    height, width = closed.shape
-    n = height * width
-    g = np.full(n, np.inf)
-    parent = np.full(n, -1, np.int32)
-    state = closed.ravel().copy()
-    heap = np.empty((4096, 3), np.float64)
-    size = 0
-    k = float((abs(gc - sc) + 1) * (abs(gr - sr) + 1))
-
-    start = sr * width + sc
-    goal = gr * width + gc
-    g[start] = 0.0
-    h0 = math.sqrt(float((gc - sc) ** 2 + (gr - sr) ** 2))
-    heap, size = _heap_push(heap, size, h0, h0, start)
-    expansions = 0
-    while size > 0:
-        node, size = _heap_pop(heap, size)
-        if state[node] == 2:
-            continue
-        state[node] = 2
-        if node == goal:
-            break
-        expansions += 1
-        r = node // width
-        c = node - r * width
-        g_node = g[node]
-        n_dirs = 8
-        if improved:
-            for d in range(4):
-                cc = c + _DCOL[d]
-                rr = r + _DROW[d]
-                if cc < 0 or cc >= width or rr < 0 or rr >= height or closed[rr, cc]:
-                    n_dirs = 4
-                    break
-        for d in range(n_dirs):
-            cc = c + _DCOL[d]
-            rr = r + _DROW[d]
-            if cc < 0 or cc >= width or rr < 0 or rr >= height:
-                continue
-            nb = rr * width + cc
-            if state[nb] == 1 or state[nb] == 2:
-                continue
-            if d >= 4:
-                if closed[r, cc] or closed[rr, c]:
-                    continue
-                step = SQRT2
-            else:
-                step = 1.0
-            ng = g_node + step * (1.0 + penalty[rr, cc])
+            ng = g_node + (step * (1.0 + penalty[rr, cc]) if weighted else step)
             if ng >= g[nb]:
                 continue
             g[nb] = ng
