@@ -53,27 +53,26 @@ def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: 
     cmd = [sys.executable, "-P", "-m", "fleet.cli", "agv", options.scenario_arg]
     for name in names:
         cmd += ["--name", name]
-    cmd += ["--connect", endpoint, "--prefix", prefix]
-    if options.algorithm:
-        cmd += ["--algorithm", options.algorithm]
-    if options.profile:
-        cmd += ["--profile", options.profile]
-    if options.zenoh_config:
-        cmd += ["--zenoh-config", options.zenoh_config]
-    return cmd
+    return cmd + _run_options(options, endpoint, prefix)
 
 
 def recorder_command(options: FleetOptions, endpoint: str, prefix: str, run_id: str) -> list[str]:
     cmd = [sys.executable, "-P", "-m", "fleet.cli", "record", options.scenario_arg]
-    cmd += ["--connect", endpoint, "--prefix", prefix, "--run-id", run_id]
-    cmd += ["-o", str(options.record_path)]
-    if options.algorithm:
-        cmd += ["--algorithm", options.algorithm]
-    if options.profile:
-        cmd += ["--profile", options.profile]
-    if options.zenoh_config:
-        cmd += ["--zenoh-config", options.zenoh_config]
-    return cmd
+    cmd += ["--run-id", run_id, "-o", str(options.record_path)]
+    return cmd + _run_options(options, endpoint, prefix)
+
+
+def _run_options(options: FleetOptions, endpoint: str, prefix: str) -> list[str]:
+    """What every child of the run is told alike: where the bus is, and the overrides."""
+    args = ["--connect", endpoint, "--prefix", prefix]
+    for flag, value in (
+        ("--algorithm", options.algorithm),
+        ("--profile", options.profile),
+        ("--zenoh-config", options.zenoh_config),
+    ):
+        if value:
+            args += [flag, value]
+    return args
 
 
 def run_fleet(
