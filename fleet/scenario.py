@@ -148,7 +148,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         raise ScenarioError(f"{where}: not valid TOML: {err}") from None
     check_keys(doc, TOP_KEYS, "")
     name = get_str(doc, "name", "", default=path.stem if path else "scenario")
-    dt = get_number(doc, "dt", "", default=0.1, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
+    dt = get_number(doc, "dt", "", default=DwaConfig.dt, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
     profile = get_str(doc, "profile", "", default=DEFAULT, choices=PROFILES)
     grid = _parse_map(get_table(doc, "map", "", required=True), path, name, doc)
     planner_defaults = get_table(doc, "planner", "")
