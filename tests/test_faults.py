@@ -42,7 +42,7 @@ def test_agvs_and_recorder_exit_3_within_2_s_saying_why_when_the_world_is_killed
     common = ["crossing", "--prefix", prefix]
     path = tmp_path / "partial.mcap"
     world = subprocess.Popen(
-        [*CLI, "world", *common, "--listen", endpoint, "--realtime", "4", "-q"],
+        [*CLI, "world", *common, "--listen", endpoint, "--realtime", "8", "-q"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
@@ -57,7 +57,7 @@ def test_agvs_and_recorder_exit_3_within_2_s_saying_why_when_the_world_is_killed
         text=True,
     )
     agv_pid("north")
-    time.sleep(3.0)  # mid-run: the crossing takes 44 s simulated, 11 s at 4x
+    time.sleep(3.0)  # mid-run: the crossing takes 44 s simulated, 11 s at 8x
     world.kill()
     killed = time.monotonic()
     _, agv_err = agvs.communicate(timeout=30)
@@ -77,7 +77,7 @@ def test_a_stopped_agv_rejoins_within_the_grace_period_and_the_run_is_unchanged(
     """SIGSTOP for 3 s: the AGV's liveliness lapses (1 s lease) and it answers nothing;
     the clock waits, then it goes on as if nothing had happened."""
     run = subprocess.Popen(
-        [*CLI, "run", "crossing", "--realtime", "4", "--json", "-q", "--no-record"],
+        [*CLI, "run", "crossing", "--realtime", "8", "--json", "-q", "--no-record"],
         stdout=subprocess.PIPE,
         text=True,
     )
@@ -141,7 +141,7 @@ def test_a_cut_link_pauses_the_clock_and_the_agv_rejoins_or_is_failed_after_the_
     with _namespace_link() as (ns, address, cut):
         endpoint = _free_endpoint(address)
         world = subprocess.Popen(
-            [*CLI, "world", *common, "--listen", endpoint, "--realtime", "4", "--json", "-q"],
+            [*CLI, "world", *common, "--listen", endpoint, "--realtime", "8", "--json", "-q"],
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
