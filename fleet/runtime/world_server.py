@@ -139,8 +139,8 @@ class WorldServer:
                 if lost is not None and now - lost > self.grace:
                     self.world.mark_failed(name, self._why_failed(name))
                     del self._lost[name]
-            lost = any(name in self._lost for name in waiting)
-            if lost and (self._rejoined or now - sent > RESEND_S):
+            someone_lost = any(name in self._lost for name in waiting)
+            if someone_lost and (self._rejoined or now - sent > RESEND_S):
                 self.bus.publish(keys.WORLD_TICK, tick)
                 sent, self._rejoined = now, False
             try:
