@@ -166,3 +166,25 @@ def open_client(
                     "(none listening, or it refused these credentials)"
                 ) from None
             time.sleep(0.05)
+
+
+def refuses(endpoint: str, timeout: float = 0.3) -> bool:
+    """Whether nothing listens at ``endpoint`` any more: a connection there is refused
+    (the process that listened died), which a cut link never answers (it times out or
+    is unreachable). False when unsure, and for transports this cannot probe."""
+    proto, _, address = endpoint.partition("/")
+    address = address.split("?")[0].split("#")[0]
+    try:
+        if proto == "unixsock-stream":
+            with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+                s.settimeout(timeout)
+                s.connect(address)
+        elif proto in ("tcp", "tls"):
+            host, _, port = address.rpartition(":")
+            with socket.create_connection((host.strip("[]"), int(port)), timeout=timeout):
+                pass
+        return False
+    except (ConnectionRefusedError, FileNotFoundError):
+        return True
+    except (OSError, ValueError):
+        return False

@@ -38,7 +38,7 @@ from mcap.records import Attachment, Channel, Chunk, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.writer import MCAP0_MAGIC
 
-from bridge.keys import agv_name, message_type
+from bridge.keys import WORLD_TICK, agv_name, message_type
 from bridge.messages import MessageError, from_dict
 from planner.errors import BadInputError
 from planner.grid_map import MapError
@@ -321,3 +321,13 @@ def _read_stream(f, path: Path) -> Recording:
     if truncated and not (messages or metadata or attachments):
         raise RecordingError(f"{path}: {why}, and nothing could be recovered from it")
     return Recording(path, messages, metadata, attachments, topics, truncated, note)
+
+
+def held_seconds(path) -> float | None:
+    """The simulated time of a recording's last readable tick; None if it has none."""
+    try:
+        rec = open_recording(path)
+    except RecordingError:
+        return None
+    ticks = rec.of(WORLD_TICK)
+    return (ticks[-1].log_time_ns - rec.log_time_zero_ns) / 1e9 if ticks else None

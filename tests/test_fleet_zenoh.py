@@ -111,7 +111,8 @@ def _failure_detected_within(sig: int) -> tuple[float, dict]:
         if world.records["north"].status == "failed" and "north" not in marked:
             marked["north"] = time.monotonic()
 
-    with hosted_world("crossing", realtime=8.0, progress=progress) as (_, _, server, _):
+    # no grace period: failed as soon as it is lost (test_faults: what a grace period does)
+    with hosted_world("crossing", realtime=8.0, grace=0.0, progress=progress) as (_, _, server, _):
         pid = agv_pid("north")
         result = {}
         runner = threading.Thread(target=lambda: result.update(summary=server.run()))
@@ -168,7 +169,7 @@ def _ps_args(pids) -> dict[int, str]:
 
 def test_ps_names_each_agv_and_kill_9_of_one_by_name_fails_only_it():
     proc = subprocess.Popen(
-        [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8", "--no-record"],
+        [*CLI, "run", "crossing", "--json", "-q", "--realtime", "8", "--no-record", "--grace=1"],
         stdout=subprocess.PIPE,
         text=True,
     )

@@ -1,10 +1,12 @@
 """Recording a real fleet run: the recorder process on the bus, and the same
-recording from both modes; a recorder killed with -9 loses only its last chunk."""
+recording from both modes; a recorder killed with -9 loses only its last chunk, and the
+run says so."""
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -71,7 +73,7 @@ def _recorder_pid(timeout=30.0) -> int:
     raise AssertionError("no recorder process")
 
 
-def test_a_recorder_killed_mid_run_leaves_a_readable_recording(tmp_path):
+def test_a_recorder_killed_mid_run_is_exit_3_naming_what_its_readable_recording_holds(tmp_path):
     path = tmp_path / "killed.mcap"
     run = subprocess.Popen(
         [*CLI, "run", "crossing", "-q", "--json", "--realtime", "5", "-o", str(path)],
@@ -83,13 +85,21 @@ def test_a_recorder_killed_mid_run_leaves_a_readable_recording(tmp_path):
     time.sleep(4.0)  # ~20 s of the 44 s simulated
     os.kill(recorder, signal.SIGKILL)
     out, err = run.communicate(timeout=300)
-    assert run.returncode == 0, err  # the run itself goes on without its recorder
+    # the run itself goes on without its recorder, then says what the file holds
+    assert run.returncode == 3, err
     ticks = json.loads(out)["ticks"]
+    assert f"recorded to {path}" not in err
+    said = re.search(rf"the recorder was killed by signal 9 at t = ([\d.]+) s: {path} holds "
+                     r"([\d.]+) of ([\d.]+) s", err)  # fmt: skip
+    assert said, err
 
     rec = open_recording(path)
     assert rec.truncated and rec.result is None
     states = len(rec.of("agv/west/command"))
     assert 50 < states < ticks  # what was recorded before the kill, less the open chunk
+    killed_at, held, total = map(float, said.groups())
+    last_tick = rec.of("world/tick")[-1].log_time_ns - rec.log_time_zero_ns
+    assert held == round(last_tick / 1e9, 1) <= killed_at < total == ticks / 10
     info = subprocess.run([*CLI, "info", str(path)], capture_output=True, text=True, timeout=60)
     assert info.returncode == 0
     assert "truncated" in info.stderr and "west" in info.stdout

@@ -24,11 +24,12 @@ from bridge.trust import (
     login_from,
 )
 from fleet import exit_codes
-from fleet.cli.arguments import UsageError, positive_float
+from fleet.cli.arguments import UsageError, non_negative_float, positive_float
 from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
 from fleet.runtime.world_server import WorldServer
+from fleet.runtime.world_watch import DEFAULT_GRACE_S, WorldGone
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
 from planner.profiles import PROFILES
@@ -52,6 +53,17 @@ def _common(p: argparse.ArgumentParser) -> None:
             "the run's Zenoh users, 'user:password' lines: the world admits only them "
             "(and writes FILE with fresh ones if it does not exist); an AGV or the recorder "
             f"logs in with its own (default: ${CREDENTIALS_ENV})"
+        ),
+    )
+    p.add_argument(
+        "--grace",
+        type=non_negative_float,
+        default=DEFAULT_GRACE_S,
+        metavar="S",
+        help=(
+            "how long a lost link may last: the world waits this long for a lost AGV "
+            "before failing it, an AGV or the recorder this long for a lost world "
+            f"(default {DEFAULT_GRACE_S:g})"
         ),
     )
 
@@ -154,6 +166,7 @@ def run_world(args: argparse.Namespace) -> int:
             scenario,
             Bus(session, prefix),
             tick_timeout=args.tick_timeout,
+            grace=args.grace,
             start_timeout=args.start_timeout,
             realtime=args.realtime,
             progress=None if args.quiet else Progress(scenario),
@@ -178,6 +191,7 @@ def run_agv(args: argparse.Namespace) -> int:
         connect_timeout=args.connect_timeout,
         zenoh_config=args.zenoh_config,
         logins=logins,
+        grace=args.grace,
     )
 
 
@@ -199,5 +213,8 @@ def run_record(args: argparse.Namespace) -> int:
             path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=facts
         ) as writer,
     ):
-        serve_recorder(Bus(session, prefix), writer, scenario.dt)
+        try:
+            serve_recorder(Bus(session, prefix), writer, scenario.dt, args.connect, args.grace)
+        except WorldGone as err:
+            raise WorldGone(f"{err}; {path} holds the run up to then") from None
     return exit_codes.OK

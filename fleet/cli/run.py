@@ -10,12 +10,13 @@ from contextlib import ExitStack
 from pathlib import Path
 
 from fleet import exit_codes
-from fleet.cli.arguments import UsageError, positive_float
+from fleet.cli.arguments import UsageError, non_negative_float, positive_float
 from fleet.runtime.inprocess import run_in_process, run_recorded
-from fleet.runtime.launcher import FleetOptions, run_fleet
+from fleet.runtime.launcher import FleetOptions, RecordingLost, run_fleet
 from fleet.runtime.progress import Progress
 from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
+from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
 from planner.profiles import PROFILES
@@ -78,7 +79,17 @@ def add_parsers(sub) -> None:
         type=positive_float,
         default=2.0,
         metavar="S",
-        help="an AGV that does not answer a tick within S seconds is failed (default 2)",
+        help="an AGV that does not answer a tick within S seconds is lost (default 2)",
+    )
+    p.add_argument(
+        "--grace",
+        type=non_negative_float,
+        default=DEFAULT_GRACE_S,
+        metavar="S",
+        help=(
+            "the clock waits up to S seconds for a lost AGV (a cut link, a hung or dead "
+            f"process) to rejoin before failing it (default {DEFAULT_GRACE_S:g})"
+        ),
     )
     p.add_argument(
         "-o",
@@ -131,16 +142,23 @@ def run(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:
             _say_interrupted(watch, record_path)
             raise
+        except RecordingLost as err:  # the run's summary, then the one line on the loss
+            _report(args, err.summary, record_path)
+            raise
         if record_path:
             print(f"recorded to {record_path}", file=sys.stderr)
-        if args.json:
-            report = {**summary.to_json(), "recording": str(record_path) if record_path else None}
-            print(json.dumps(report), flush=True)
-        else:
-            print(summary.table(), flush=True)
+        _report(args, summary, record_path)
         if view is not None and args.rerun_web:
             view.hold()
     return exit_codes.OK if summary.success else exit_codes.NOT_SUCCEEDED
+
+
+def _report(args, summary, record_path: Path | None) -> None:
+    if args.json:
+        report = {**summary.to_json(), "recording": str(record_path) if record_path else None}
+        print(json.dumps(report), flush=True)
+    else:
+        print(summary.table(), flush=True)
 
 
 class _Watch:
@@ -178,6 +196,7 @@ def _run(args, scenario, record_path, progress, view):
         transport=args.transport,
         zenoh_config=args.zenoh_config,
         tick_timeout=args.tick_timeout,
+        grace=args.grace,
         record_path=record_path,
     )
     return run_fleet(scenario, options, progress=progress, tap=view)

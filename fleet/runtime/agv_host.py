@@ -24,6 +24,7 @@ from bridge.session import Login, open_client
 from fleet import exit_codes
 from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.agv_process import serve_agv
+from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
 from planner.errors import AgvFleetError
 
@@ -39,12 +40,13 @@ def serve_agvs(
     connect_timeout: float = 30.0,
     zenoh_config: str | None = None,
     logins: dict[str, Login] | None = None,
+    grace: float = DEFAULT_GRACE_S,
 ) -> int:
     """Run every named AGV, each in its own process (logged in as ``logins[name]``
     when given); the worst exit status."""
     AgvNode(scenario, names[0]).warm_up()
     logins = logins or {}
-    options = (connect, prefix, connect_timeout, zenoh_config)
+    options = (connect, prefix, connect_timeout, zenoh_config, grace)
     if len(names) == 1:
         _set_title(process_title(names[0]))
         return _serve_one(scenario, names[0], *options, logins.get(names[0]))
@@ -80,10 +82,10 @@ def process_title(name: str) -> str:
     return f"agv-fleet agv {name}"
 
 
-def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, login) -> int:
+def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, grace, login):
     try:
         with open_client(connect, connect_timeout, zenoh_config, login) as session:
-            serve_agv(scenario, name, Bus(session, prefix))
+            serve_agv(scenario, name, Bus(session, prefix), connect, grace)
     except AgvFleetError as err:
         say(f"agv-fleet agv {name}: {err}")
         return exit_codes.for_error(err)

@@ -5,6 +5,9 @@ process opens the router on a fresh endpoint and runs the world in it; so no
 process ever forks after it opened a Zenoh session. Every child is ended by
 PID on every way out: normal end, error, Ctrl-C or SIGTERM.
 
+A recorder that ends before the run does is not a recording of the run: the run
+goes on without it, and then ``RecordingLost`` says what the file holds.
+
 Every run has its own credentials and access control (see bridge.trust): they
 live in a private temporary folder (with the Unix socket) that the children
 find through an environment variable, and that is removed at the end.
@@ -30,7 +33,10 @@ from bridge.trust import CREDENTIALS_ENV, write_run_credentials
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
 from fleet.runtime.world_server import WorldServer
+from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
+from planner.errors import EnvironmentFailure
+from recordings.reader import held_seconds
 
 EXIT_GRACE_S = 5.0
 
@@ -44,6 +50,7 @@ class FleetOptions:
     transport: str = "unix"
     zenoh_config: str | None = None
     tick_timeout: float = 2.0
+    grace: float = DEFAULT_GRACE_S
     record_path: Path | None = None  # None: no recorder
 
 
@@ -64,7 +71,7 @@ def recorder_command(options: FleetOptions, endpoint: str, prefix: str, run_id: 
 
 def _run_options(options: FleetOptions, endpoint: str, prefix: str) -> list[str]:
     """What every child of the run is told alike: where the bus is, and the overrides."""
-    args = ["--connect", endpoint, "--prefix", prefix]
+    args = ["--connect", endpoint, "--prefix", prefix, "--grace", str(options.grace)]
     for flag, value in (
         ("--algorithm", options.algorithm),
         ("--profile", options.profile),
@@ -96,13 +103,13 @@ def run_fleet(
             children.append(
                 _spawn(agv_command(options, names, endpoint, prefix), child_files["agvs"])
             )
+            recorder, ended = None, {}
             if options.record_path:
-                children.append(
-                    _spawn(
-                        recorder_command(options, endpoint, prefix, run_id),
-                        child_files["recorder"],
-                    )
+                recorder = _spawn(
+                    recorder_command(options, endpoint, prefix, run_id), child_files["recorder"]
                 )
+                children.append(recorder)
+                progress = _recorder_watched(recorder, progress, ended)
             with open_router(endpoint, options.zenoh_config, guard) as session:
                 bus = Bus(session, prefix)
                 if tap:
@@ -111,6 +118,7 @@ def run_fleet(
                     scenario,
                     bus,
                     tick_timeout=options.tick_timeout,
+                    grace=options.grace,
                     realtime=options.realtime,
                     progress=progress,
                     abort_check=lambda: _exited_early(children),
@@ -119,9 +127,50 @@ def run_fleet(
                 summary = server.run()
                 if progress:
                     progress(server.world)  # the last messages, for the tap
-                return summary
+            if recorder is not None:
+                _check_recording(recorder, options.record_path, ended, summary)
+            return summary
         finally:
             shutil.rmtree(run_dir, ignore_errors=True)
+
+
+class RecordingLost(EnvironmentFailure):
+    """The run completed, its recording did not: ``summary`` is the run's."""
+
+    def __init__(self, message: str, summary: RunSummary):
+        super().__init__(message)
+        self.summary = summary
+
+
+def _recorder_watched(recorder: subprocess.Popen, progress, ended: dict):
+    """A progress callback that also notes (in ``ended["at"]``) the simulated time at
+    which the recorder process was first seen ended."""
+
+    def on_tick(world: World) -> None:
+        if "at" not in ended and recorder.poll() is not None:
+            ended["at"] = world.time
+        if progress:
+            progress(world)
+
+    return on_tick
+
+
+def _check_recording(recorder: subprocess.Popen, path: Path, ended: dict, summary) -> None:
+    """Raise RecordingLost unless the recorder stored the whole run and exited with 0."""
+    try:
+        code = recorder.wait(timeout=EXIT_GRACE_S)
+    except subprocess.TimeoutExpired:
+        code = None
+    if code == 0:
+        return
+    if code is None:
+        how = "did not finish"
+    else:
+        how = f"was killed by signal {-code}" if code < 0 else f"ended with status {code}"
+    when = f" at t = {ended['at']:.1f} s" if "at" in ended else ""
+    held = held_seconds(path)
+    holds = "nothing readable" if held is None else f"{held:.1f} of {summary.sim_time:.1f} s"
+    raise RecordingLost(f"the recorder {how}{when}: {path} holds {holds}", summary)
 
 
 def _tapped(bus: Bus, tap, progress):

@@ -2,9 +2,13 @@
 
 Tick k goes out on ``world/tick``; the world then waits for every live AGV's
 command for tick k+1 on ``agv/<name>/command``. An AGV whose liveliness token
-disappears (its process died, or hung past its 1 s lease) or that does not
-answer within ``tick_timeout`` is marked failed and stays in the world as a
-stopped obstacle at its last pose; the others go on.
+disappears (its process died, hung past its 1 s lease, or its link was cut) or
+that does not answer within ``tick_timeout`` is *lost*: the world cannot tell
+these apart, so the clock waits for it up to ``grace`` seconds, re-sending tick k
+(it may have missed it) while it waits and as soon as the AGV's token is back.
+An AGV that answers within the grace period rejoins as if nothing happened (the
+run's outcome is unchanged); after it, the AGV is failed with that reason and
+stays in the world as a stopped obstacle at its last pose; the others go on.
 """
 
 from __future__ import annotations
@@ -20,10 +24,12 @@ from bridge.messages import AgvCommand, Tick
 from fleet.runtime.lockstep import run_lockstep
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
+from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
 from planner.errors import EnvironmentFailure
 
 POLL_S = 0.02
+RESEND_S = 0.5  # while an AGV is lost, tick k goes out again this often
 
 
 class FleetStartError(EnvironmentFailure):
@@ -37,6 +43,7 @@ class WorldServer:
         bus: Bus,
         *,
         tick_timeout: float = 2.0,
+        grace: float = DEFAULT_GRACE_S,
         start_timeout: float = 30.0,
         realtime: float | None = None,
         progress: Callable[[World], None] | None = None,
@@ -46,12 +53,15 @@ class WorldServer:
         self.scenario = scenario
         self.bus = bus
         self.tick_timeout = tick_timeout
+        self.grace = grace
         self.start_timeout = start_timeout
         self.realtime = realtime
         self.progress = progress
         self.abort_check = abort_check
         self.world = World(scenario)
         self.alive: set[str] = set()
+        self._lost: dict[str, float] = {}  # AGV -> when it was lost (monotonic)
+        self._rejoined = False  # a lost AGV's token is back: re-send the tick at once
         self._commands = bus.subscribe("agv/*/command")
         self._liveliness = bus.watch_alive(f"{keys.ALIVE}/agv/*")
         self._recorder = bus.watch_alive(keys.alive_recorder()) if recorder else None
@@ -62,12 +72,15 @@ class WorldServer:
         paced_from = time.monotonic()
 
         def after_tick(world: World) -> None:
+            nonlocal paced_from
             if self.progress:
                 self.progress(world)
             if self.realtime and not world.ended:
                 delay = paced_from + world.time / self.realtime - time.monotonic()
                 if delay > 0:
                     time.sleep(delay)
+                elif delay < -self.tick_timeout:  # after a pause: go on at pace, no rush
+                    paced_from -= delay
 
         return run_lockstep(self.world, self._collect, self.bus.publish, after_tick=after_tick)
 
@@ -100,32 +113,46 @@ class WorldServer:
                     self.bus.count_invalid(key, "a liveliness token of no AGV of this run")
                 elif is_alive:
                     self.alive.add(name)
+                    self._rejoined |= name in self._lost
                 else:
                     self.alive.discard(name)
-                    self.world.mark_failed(name, "process died or hung (liveliness lost)")
+                    self._lost.setdefault(name, time.monotonic())
         except queue.Empty:
             pass
 
     def _collect(self, tick: Tick, world: World) -> dict[str, AgvCommand]:
-        """Every live AGV's command for the next tick, until all answered, died or timed
-        out."""
+        """Every live AGV's command for the next tick, until each answered or was lost
+        for longer than the grace period."""
         replies: dict[str, AgvCommand] = {}
         wanted = tick.tick + 1
-        deadline = time.monotonic() + self.tick_timeout
+        started = sent = time.monotonic()
         while True:
             self._update_liveliness()
             waiting = [n for n in self.world.live_agvs() if n not in replies]
             if not waiting:
                 return replies
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                for name in waiting:
-                    self.world.mark_failed(name, f"no answer within {self.tick_timeout:g} s")
-                return replies
+            now = time.monotonic()
+            for name in waiting:
+                if now - started > self.tick_timeout:
+                    self._lost.setdefault(name, started + self.tick_timeout)
+                lost = self._lost.get(name)
+                if lost is not None and now - lost > self.grace:
+                    self.world.mark_failed(name, self._why_failed(name))
+                    del self._lost[name]
+            someone_lost = any(name in self._lost for name in waiting)
+            if someone_lost and (self._rejoined or now - sent > RESEND_S):
+                self.bus.publish(keys.WORLD_TICK, tick)
+                sent, self._rejoined = now, False
             try:
-                received = self._commands.get(timeout=min(POLL_S, remaining))
+                received = self._commands.get(timeout=POLL_S)
             except queue.Empty:
                 continue
             command = received.msg
             if command.tick == wanted and received.key == keys.agv_command(command.name):
                 replies[command.name] = command
+                self._lost.pop(command.name, None)
+
+    def _why_failed(self, name: str) -> str:
+        if name not in self.alive:
+            return f"liveliness lost for more than {self.grace:g} s (died, hung or cut off)"
+        return f"no answer for more than {self.tick_timeout + self.grace:g} s"

@@ -1,0 +1,74 @@
+"""Whether the world is still there, for a process that serves it (an AGV, the recorder).
+
+The world's liveliness token goes when the run ends (after its final tick and
+result) and also when the link to the world is lost. A token that goes before
+the run ended is either: if the world's endpoint now refuses connections,
+nothing listens there any more (its process died) and the run is over at once;
+otherwise the link may come back (a Zenoh client reconnects by itself) and the
+process waits up to the grace period, as the world waits for it.
+"""
+
+from __future__ import annotations
+
+import queue
+import time
+
+from bridge import keys
+from bridge.bus import Bus
+from bridge.session import refuses
+from planner.errors import EnvironmentFailure
+
+PROBE_EVERY_S = 0.5
+# how long a lost link may last before the world fails an AGV (and an AGV or the
+# recorder gives up on the world): long enough for a network to recover
+DEFAULT_GRACE_S = 10.0
+
+
+class WorldGone(EnvironmentFailure):
+    """The world never appeared, or went away without ending the run."""
+
+
+class WorldWatch:
+    def __init__(self, bus: Bus, endpoint: str, grace: float, start_timeout: float):
+        self.endpoint = endpoint
+        self.grace = grace
+        self.start_timeout = start_timeout
+        self._tokens = bus.watch_alive(keys.alive_world())
+        self._started = time.monotonic()
+        self._seen = False
+        self._lost_since: float | None = None
+        self._probed = 0.0
+
+    def over(self, ended: bool, at: float) -> bool:
+        """Call when no message is waiting: True once the world ended the run (``ended``:
+        its final message came) and left. Raises WorldGone when it left without ending it
+        (``at``: the simulated time reached) or never came."""
+        try:
+            while True:
+                _, alive = self._tokens.get_nowait()
+                self._seen |= alive
+                if alive:
+                    self._lost_since = None
+                elif self._lost_since is None:
+                    self._lost_since = time.monotonic()
+        except queue.Empty:
+            pass
+        now = time.monotonic()
+        if not self._seen:
+            if now - self._started > self.start_timeout:
+                raise WorldGone(f"no world appeared within {self.start_timeout:g} s")
+            return False
+        if self._lost_since is None:
+            return False
+        if ended:
+            return True
+        if now - self._probed > PROBE_EVERY_S:
+            self._probed = now
+            if refuses(self.endpoint):
+                raise WorldGone(
+                    f"the world went away at t = {at:.1f} s without ending the run "
+                    f"(nothing listens at {self.endpoint} any more)"
+                )
+        if now - self._lost_since > self.grace:
+            raise WorldGone(f"lost the world at t = {at:.1f} s for more than {self.grace:g} s")
+        return False
