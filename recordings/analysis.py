@@ -34,6 +34,7 @@ import numpy as np
 from planner import path_metrics
 from planner.agv_status import FINISHED
 from planner.distance_field import DistanceField
+from planner.fusion import GLOBAL_ALGORITHM
 from planner.motion import world_velocity
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
@@ -101,11 +102,19 @@ class RunAnalysis:
         return json_ready(asdict(self))
 
 
+_VARIANT_OF_GLOBAL = {a: variant for variant, a in GLOBAL_ALGORITHM.items()}
+
+
 def _algorithm(run: dict, series: RunSeries) -> str:
+    """The planner variant of a run (fusion, astar-dwa, dwa), as the run facts name it or
+    else as its plans tell (a run's plans name their global A*; a plan-only recording's are
+    the A* variants themselves)."""
     given = run.get("algorithm")
     if given and given != "scenario's":
         return str(given)
     planners = {p.get("algorithm") for plans in series.plans.values() for p in plans}
+    if run.get("mode") != "plan":
+        planners = {_VARIANT_OF_GLOBAL.get(a, a) for a in planners}
     return "+".join(sorted(str(a) for a in planners if a))
 
 
