@@ -258,7 +258,7 @@ def make_episode(seed: int) -> Episode | None:
         aside = _aside(grid, route, route[j])
         if k - j >= 10 and aside is not None:
             walk = float(rng.uniform(0.3, 0.8))
-            points = (*route[j : k + 1 : 10][::-1], aside)
+            points = (*route[j : k + 1][::-1], aside)
             start_at = float(rng.uniform(0, 20))
             moving.append(MovingObstacle("head-on", WALKER_RADIUS, points, walk, "once", start_at))
             events.append("head-on")
