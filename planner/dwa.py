@@ -40,10 +40,7 @@ The default profile adds a term to Eq. (10), normalised like the others:
 ``on_route`` (the trajectory stays near the global route's current segment);
 and it picks, among the samples scoring near the best, the one that changes
 the last cycle's acceleration least (``steady_choice``), so the chosen
-acceleration stops flipping every cycle. On the route it bounds the speed by
-the room to brake along the path (``room_ahead``, Fox et al.'s rule) instead of
-the least clearance, which holds an AGV facing its travel along a wall at
-0.28 m/s; in the final approach it drives without turning (``steady_heading``).
+acceleration stops flipping every cycle.
 
 Beyond the paper, for arriving (at 0.2 m/s² an AGV at 2 m/s needs 10 m to
 stop, and a 3 s rollout's end lies past a nearby target, so plain DWA circles
@@ -250,8 +247,6 @@ def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0
 
 
 _NO_DISCS = np.zeros((0, 5))
-ROUTE_TOLERANCE = 0.25  # m: a trajectory this near the route's segment follows the route
-_NO_WALLS = np.full((2, 2), 1e9)  # a distance field with nothing static: the discs alone
 
 
 def relevant_discs(
@@ -274,84 +269,17 @@ def relevant_discs(
     return np.ascontiguousarray(discs[gap_now - agv_reach - disc_reach < bound])
 
 
-def admissible_mask(
-    config: DwaConfig,
-    commands: np.ndarray,
-    clearance: np.ndarray,
-    braking_room: np.ndarray | None = None,
-) -> np.ndarray:
-    """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance.
-
-    ``braking_room`` (the default profile's ``room_ahead``) replaces the clearance in the
-    linear speed's bound; the turn rate's bound keeps the clearance.
-    """
+def admissible_mask(config: DwaConfig, commands: np.ndarray, clearance: np.ndarray) -> np.ndarray:
+    """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance."""
     room = np.maximum(clearance, 0.0)
-    linear = room if braking_room is None else np.maximum(braking_room, 0.0)
     return (
         (clearance > 0.0)
         & (
             np.hypot(commands[:, 0], commands[:, 1])
-            <= np.sqrt(2.0 * linear * config.max_accel) + _EPS
+            <= np.sqrt(2.0 * room * config.max_accel) + _EPS
         )
         & (np.abs(commands[:, 2]) <= np.sqrt(2.0 * room * config.max_alpha) + _EPS)
     )
-
-
-def room_ahead(
-    config: DwaConfig, commands: np.ndarray, xs: np.ndarray, ys: np.ndarray, discs: np.ndarray
-) -> np.ndarray:
-    """(N,) how far each sample can brake without contact: the length of its (contact-free)
-    path over the horizon, at most the least gap to a moving disc over the horizon.
-
-    Eq. (7) bounds the speed by the trajectory's least clearance, which caps an AGV
-    driving along a wall at 0.2 m by sqrt(2 a 0.2) = 0.28 m/s at Table-1 limits
-    however clear the way ahead is: the paper slides sideways to the middle of a
-    corridor to get more, an AGV facing its travel cannot. Braking along a
-    contact-free trajectory that is no longer than the predicted one cannot touch a
-    known obstacle (Fox et al. 1997 bound the speed by the distance along the path);
-    stopping within the horizon (v <= 2 a T, 1.2 m/s at Table 1) also keeps the stop
-    within the sensing radius, where a newly sensed wall can be. Moving discs keep
-    the paper's bound: their future is only predicted. ``DwaPlanner.plan`` grants this
-    room only to trajectories that follow the global route (within ``ROUTE_TOLERANCE``),
-    whose segments keep the body clear; off it, near corners and narrow gaps, the
-    paper's bound keeps the AGV slow enough to line up. Towards the final goal
-    ``stop_room`` adds the wall that may stand behind it.
-    """
-    room = np.hypot(commands[:, 0], commands[:, 1]) * (config.steps * config.dt)
-    if len(discs):
-        gaps = min_clearance(xs, ys, _NO_WALLS, 1.0, discs, config.dt, config.radius)
-        room = np.minimum(room, gaps)
-    return room
-
-
-def stop_room(
-    config: DwaConfig, field: DistanceField, target_xy, distance: float, speed: np.ndarray
-) -> np.ndarray:
-    """(N,) the room to brake before the final goal when ``room_ahead`` lets the AGV run fast:
-    its ``distance`` less how far past it a constant command's horizon reaches beyond the
-    clearance round the goal (Eq. 7 for a wall just behind the goal).
-
-    The horizon of a fast constant command runs past the goal; with a wall behind it
-    every sample would touch it at once (nothing admissible, 0.8 m from the goal at
-    0.9 m/s). Braking early enough that the horizon stops short keeps arrival smooth.
-    """
-    behind = max(float(field.distance_at(*target_xy)) - config.radius, 0.0)
-    return np.maximum(
-        np.minimum(distance, distance + behind - speed * (config.steps * config.dt)), 0.0
-    )
-
-
-def steady_heading(commands: np.ndarray) -> np.ndarray:
-    """The samples turning least (|omega| as low as the window allows), for the final approach.
-
-    A body that turns while it translates bends its world-frame path at the turn
-    rate: sideways at 0.4 m/s and 20 deg/s it circles the goal 1.2 m away, for
-    ever. Heading does not matter for the last metres of a disc, so the final
-    approach brakes the rotation and then drives straight lines, which the
-    nearness score makes converge on the goal.
-    """
-    turn = np.abs(commands[:, 2])
-    return turn <= turn.min() + _EPS
 
 
 def normalised(term: np.ndarray) -> np.ndarray:
@@ -400,20 +328,16 @@ def facing(commands: np.ndarray) -> np.ndarray:
     return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
 
 
-def route_deviation(xs: np.ndarray, ys: np.ndarray, segment) -> np.ndarray:
-    """(N,) the largest distance of each trajectory (N, K) from the route ``segment``."""
+def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
+    """cap - the largest distance of each trajectory (N, K) from the route ``segment``
+    (capped at ``cap``): trajectories that stay on the global route score highest, so
+    the AGV lines up with a narrow passage the route goes through before it gets there."""
     (ax, ay), (bx, by) = segment
     dx, dy = bx - ax, by - ay
     length2 = dx * dx + dy * dy
     t = np.zeros_like(xs) if length2 < _EPS else ((xs - ax) * dx + (ys - ay) * dy) / length2
     t = np.clip(t, 0.0, 1.0)
-    return np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
-
-
-def on_route(off: np.ndarray, cap: float) -> np.ndarray:
-    """cap - the trajectories' ``route_deviation`` (capped at ``cap``): trajectories that
-    stay on the global route score highest, so the AGV lines up with a narrow passage the
-    route goes through before it gets there."""
+    off = np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
     return cap - np.minimum(off, cap)
 
 
@@ -491,31 +415,17 @@ class DwaPlanner:
         clearance = min_clearance(
             xs, ys, field.samples, 1.0 / field.spacing, _NO_DISCS, cfg.dt, cfg.radius, *field.origin
         )
-        off = None if segment is None else route_deviation(xs, ys, segment)
-        follows = None  # the samples granted the room ahead (the default, on the route)
-        if self.behaviour.room_ahead and off is not None:
-            follows = off <= ROUTE_TOLERANCE
-        braking = None if follows is None else room_ahead(cfg, commands, xs, ys, _NO_DISCS)
-        bound = float(clearance.max() if braking is None else max(clearance.max(), braking.max()))
-        discs = relevant_discs(cfg, pose, xs, ys, discs, bound)
+        discs = relevant_discs(cfg, pose, xs, ys, discs, float(clearance.max()))
         if len(discs):
             clearance = min_clearance(
                 xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
             )
-            if braking is not None:
-                braking = room_ahead(cfg, commands, xs, ys, discs)
-        if braking is not None:
-            braking = np.where(follows, braking, clearance)
-        mask = admissible_mask(cfg, commands, clearance, braking)
+        mask = admissible_mask(cfg, commands, clearance)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
             room = math.dist(pose[:2], target_xy)
-            if follows is not None:
-                room = stop_room(cfg, field, target_xy, room, speed)
-            limit = np.maximum(np.sqrt(2.0 * cfg.max_accel * room), float(speed.min()))
+            limit = max(math.sqrt(2.0 * cfg.max_accel * room), float(speed.min()))
             mask &= speed <= limit + _EPS
-        if approach:
-            mask &= steady_heading(commands)
         ok = np.flatnonzero(mask)
         if ok.size == 0:
             if self.behaviour.evade:
@@ -548,8 +458,10 @@ class DwaPlanner:
             reached,
             self._extra(commands[ok]),
         )
-        if off is not None and self.behaviour.route_weight > 0:
-            g = g + self.behaviour.route_weight * normalised(on_route(off[ok], cfg.clearance_cap))
+        if segment is not None and self.behaviour.route_weight > 0:
+            g = g + self.behaviour.route_weight * normalised(
+                on_route(xs[ok], ys[ok], segment, cfg.clearance_cap)
+            )
         standing = math.hypot(command[0], command[1]) < _EPS
         if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
             change = jerk(commands[ok], command, command if previous is None else previous)

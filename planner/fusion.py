@@ -25,8 +25,7 @@ The default profile (``planner/local_behaviour.py``) adds: the initial turn
 driven within the omega and alpha limits; every cycle in which new obstacles
 were sensed, a check of the remaining route against them and an immediate
 replan when they block it; a final approach scored by nearness to the goal;
-arrival only when stopped inside the tolerance (a goal left behind the body
-after an overshoot is turned to first); bounded recoveries
+arrival only when stopped inside the tolerance; bounded recoveries
 (``planner/recovery.py``) and then ``failed`` with the reason.
 """
 
@@ -260,29 +259,12 @@ class FusionController:
             and final
             and math.dist(position, target) <= self.config.approach_distance
         )
-        if approach and self._behind(pose, target) and not self.dwa.threatened(pose, moving):
-            error = float(
-                wrap_angle(math.atan2(target[1] - pose[1], target[0] - pose[0]) - pose[2])
-            )
-            cmd = turn_command(self.config.dwa, error, command)
-            return _step(cmd or braking_command(self.config.dwa, command), "driving", target)
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
             approach=approach, segment=(self._segment_start(), target),
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
-
-    def _behind(self, pose, target: Point) -> bool:
-        """True when ``target`` lies behind the body of an AGV that cannot reverse.
-
-        The final approach drives without turning (``dwa.steady_heading``), so a goal
-        behind such an AGV (after an overshoot) is reached by turning towards it first.
-        """
-        if self.config.dwa.min_vx < 0:
-            return False
-        bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
-        return abs(float(wrap_angle(bearing - pose[2]))) > math.pi / 2
 
     def _segment_start(self) -> Point:
         """Where the route's current segment starts: the previous key node, or where the

@@ -22,7 +22,6 @@ class LocalBehaviour:
     smooth_arrival: bool  # arrived = inside the tolerance and stopped, braking within limits
     recorded_turn: bool  # the initial heading turn is driven within omega/alpha limits
     final_approach: bool  # near the goal: score by the distance to it, not by clearance
-    room_ahead: bool  # Eq. 7's speed bound by the room to brake along the path, not clearance
     route_weight: float  # weight of the term keeping trajectories on the global route
     face_travel_weight: float  # weight of the term facing the body along its travel
     steady_tolerance: float  # keep the acceleration unless this near the best (score spread)
@@ -41,7 +40,6 @@ def local_behaviour(profile: str, *, free_heading: bool = False) -> LocalBehavio
         smooth_arrival=on,
         recorded_turn=on,
         final_approach=on,
-        room_ahead=on,
         route_weight=0.3 if on else 0.0,
         face_travel_weight=0.3 if on and not free_heading else 0.0,
         steady_tolerance=STEADY_TOLERANCE if on else 0.0,

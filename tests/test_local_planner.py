@@ -228,30 +228,3 @@ def test_the_planner_profile_is_a_scenario_key():
     assert parse_scenario(text.format("default")).agvs[0].config.profile == "default"
     with pytest.raises(ScenarioError, match="profile"):
         parse_scenario(text.format("fast"))
-
-
-def test_along_a_wall_on_the_route_the_speed_is_bounded_by_the_room_ahead():
-    # a straight corridor; the AGV 0.5 m from the lower wall (clearance 0.2 m) at 1 m/s
-    field = DistanceField.from_grid(parse_text_grid("\n".join(["#" * 30, "." * 30, "#" * 30])))
-    pose, command, target = (2.0, 1.5, 0.0), (1.0, 0.0, 0.0), (28.0, 1.5)
-    segment = ((0.5, 1.5), target)
-    paper = DwaPlanner(DwaConfig(), field).plan(pose, command, target, segment=segment)
-    default = DwaPlanner(DwaConfig(), field, local_behaviour("default"))
-    ahead = default.plan(pose, command, target, segment=segment)
-    # Eq. 7 with the least clearance allows sqrt(2 * 0.2 * 0.2) = 0.28 m/s: the paper brakes
-    assert not paper.admissible
-    assert ahead.admissible and math.hypot(*ahead.command[:2]) >= 1.0 - 0.02 - 1e-9
-    # off the route the paper's bound holds: the room ahead is for following the route
-    aside = default.plan(pose, command, target, segment=((0.5, 0.9), (28.0, 0.9)))
-    assert not aside.admissible
-
-
-@pytest.mark.parametrize("name", ["corridor", "crossing", "warehouse"])
-def test_the_default_is_no_slower_than_the_paper_on_the_built_in_scenarios(name):
-    """Simulated time, not wall time: the last arrival of every AGV, both profiles."""
-    runs = {}
-    for profile in ("default", "paper"):
-        summary, _ = run(with_profile(load_scenario(name), profile))
-        assert all(a.status == "arrived" and a.collisions == 0 for a in summary.agvs), profile
-        runs[profile] = max(a.arrival_time for a in summary.agvs)
-    assert runs["default"] <= runs["paper"], runs
