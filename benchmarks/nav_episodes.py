@@ -5,7 +5,8 @@ a start and a goal at least 10 m apart, and from the seed:
 
 - the goal in a dock (a 1-cell-wide recess 2 cells deep), a 1-cell pocket
   (3 sides walled) or in the open;
-- a walker crossing the route at a random place, speed and time, and/or one
+- a walker crossing the route once at a random place, speed and time (on a
+  straight line clear of the walls, from one side to the other), and/or one
   coming head-on along the route;
 - a temporary wall across the route, there from the start (sensed once
   within the sensing radius: early) or appearing just before the AGV gets
@@ -124,17 +125,75 @@ def path_length(path) -> float:
 
 
 def _aside(grid: GridMap, route, point) -> tuple[float, float] | None:
-    """The free cell centre nearest ``point`` that is at least 1.5 m from every route point."""
+    """The free cell centre nearest ``point`` that is at least 1.5 m from every route point
+    and that a walker's disc reaches from ``point`` in a straight line clear of the walls."""
+    field = DistanceField.from_grid(grid)
     route_xy = np.asarray(route)
     best, best_d = None, math.inf
     for row in range(grid.height):
         for col in range(grid.width):
             centre = grid.centre_of((col, row))
-            if grid.blocked[row, col] or math.dist(centre, point) >= best_d:
+            d = math.dist(centre, point)
+            if grid.blocked[row, col] or d >= best_d:
                 continue
-            if np.hypot(*(route_xy - centre).T).min() >= 1.5:
-                best, best_d = centre, math.dist(centre, point)
+            if np.hypot(*(route_xy - centre).T).min() < 1.5:
+                continue
+            direction = ((centre[0] - point[0]) / d, (centre[1] - point[1]) / d)
+            if _free_extent(field, point, direction, d) >= d - 0.05:
+                best, best_d = centre, d
     return best
+
+
+WALKER_RADIUS = 0.35
+CROSSING_HALF = 3.0  # m: a crossing walker starts and ends at most this far from the route
+CROSSING_CLEAR = 1.0  # m: ... and at least this far, so that it leaves the route free
+
+
+def _free_extent(field: DistanceField, point, direction, longest: float) -> float:
+    """How far a walker's disc moves from ``point`` along ``direction`` before touching a wall
+    (or the map's edge), up to ``longest``."""
+    step, reach = 0.05, 0.0
+    while reach + step <= longest:
+        x = point[0] + (reach + step) * direction[0]
+        y = point[1] + (reach + step) * direction[1]
+        inside = (
+            WALKER_RADIUS <= x <= SIZE - WALKER_RADIUS
+            and WALKER_RADIUS <= y <= SIZE - WALKER_RADIUS
+        )
+        if not inside or float(field.distance_at(x, y)) < WALKER_RADIUS:
+            break
+        reach += step
+    return reach
+
+
+def _crossing(grid: GridMap, route, rng, speed: float) -> MovingObstacle | None:
+    """A walker crossing the route once at a random place, speed and time, on a straight line
+    that keeps its disc off the walls, from one side to the other (None: no such place found).
+
+    It is timed to reach the route within 5 s of the AGV's nominal arrival there, and stops
+    at least ``CROSSING_CLEAR`` from the route, so it never parks in the AGV's way.
+    """
+    field = DistanceField.from_grid(grid)
+    walk = float(rng.uniform(0.3, 0.8))
+    offset = float(rng.uniform(-5, 5))
+    side = 1 if rng.random() < 0.5 else -1
+    for _ in range(20):
+        k = int(rng.integers(len(route) // 5, 4 * len(route) // 5))
+        (x0, y0), (x1, y1) = route[k], route[min(k + 5, len(route) - 1)]
+        heading = math.atan2(y1 - y0, x1 - x0) + math.pi / 2
+        unit = (side * math.cos(heading), side * math.sin(heading))
+        back = _free_extent(field, (x0, y0), (-unit[0], -unit[1]), CROSSING_HALF)
+        ahead = _free_extent(field, (x0, y0), unit, CROSSING_HALF)
+        if min(back, ahead) < CROSSING_CLEAR:
+            continue
+        ends = (
+            (x0 - back * unit[0], y0 - back * unit[1]),
+            (x0 + ahead * unit[0], y0 + ahead * unit[1]),
+        )
+        meet = path_length(route[: k + 1]) / speed + offset
+        start_at = max(0.0, meet - back / walk)
+        return MovingObstacle("crossing", WALKER_RADIUS, ends, walk, "once", start_at)
+    return None
 
 
 def _recess(blocked: np.ndarray, rng, depth: int, keep) -> tuple[int, int] | None:
@@ -188,29 +247,20 @@ def make_episode(seed: int) -> Episode | None:
     length = path_length(route)
     speed = NOMINAL_SPEED[vehicle]
     events, moving, temporary = [], [], []
-    if rng.random() < 0.6:  # a walker crossing the route
-        k = int(rng.integers(len(route) // 5, 4 * len(route) // 5))
-        (x0, y0), (x1, y1) = route[k], route[min(k + 5, len(route) - 1)]
-        heading = math.atan2(y1 - y0, x1 - x0) + math.pi / 2
-        half, walk = 3.0, float(rng.uniform(0.3, 0.8))
-        ends = [
-            (min(max(x0 + s * half * math.cos(heading), 0.1), SIZE - 0.1),
-             min(max(y0 + s * half * math.sin(heading), 0.1), SIZE - 0.1))
-            for s in (-1, 1)
-        ]  # fmt: skip
-        meet = path_length(route[: k + 1]) / speed + float(rng.uniform(-5, 5))
-        start_at = max(0.0, meet - half / walk)
-        moving.append(MovingObstacle("crossing", 0.35, tuple(ends), walk, "bounce", start_at))
-        events.append("crossing")
+    if rng.random() < 0.6:  # a walker crossing the route once, from a random side
+        walker = _crossing(grid, route, rng, speed)
+        if walker is not None:
+            moving.append(walker)
+            events.append("crossing")
     if rng.random() < 0.4:  # a walker coming head-on along the route, then stepping aside
         k = int(rng.integers(len(route) // 2, len(route) - 1))
         j = max(30, k - 80)  # it turns off at least 3 m before the start
         aside = _aside(grid, route, route[j])
         if k - j >= 10 and aside is not None:
             walk = float(rng.uniform(0.3, 0.8))
-            points = (*route[j : k + 1 : 10][::-1], aside)
+            points = (*route[j : k + 1][::-1], aside)
             start_at = float(rng.uniform(0, 20))
-            moving.append(MovingObstacle("head-on", 0.35, points, walk, "once", start_at))
+            moving.append(MovingObstacle("head-on", WALKER_RADIUS, points, walk, "once", start_at))
             events.append("head-on")
     if rng.random() < 0.6:  # a wall across the route
         late = rng.random() < 0.5
