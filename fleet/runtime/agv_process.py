@@ -1,7 +1,7 @@
 """One AGV on the bus: ``AgvNode`` fed by ``world/tick``, answering on its command key.
 
-It runs until the world ends the run (its final tick) and leaves; a world that
-goes without ending it is an error (see ``fleet.runtime.world_watch``), so an
+It runs until the world's final tick ends the run; a world that goes without
+ending it is an error (see ``fleet.runtime.world_watch``), so an
 AGV never waits forever and never calls an unfinished run a success. It
 refuses to start when an AGV of its name is already on the bus, and ignores
 (counting them on the bus, logged once) ticks that do not list exactly the
@@ -49,17 +49,14 @@ def serve_agv(
     bus.declare_alive(keys.alive_agv(name))
     answered = 0
     last_tick, last_time, last_out = -1, 0.0, None
-    ended = False
     while True:
         try:
             tick = ticks.get(timeout=POLL_S).msg
         except queue.Empty:
-            if world.over(ended, last_time):
-                return answered
+            world.check(last_time)
             continue
         if tick.final:
-            ended = True  # the run's end state: the world's token goes next
-            continue
+            return answered  # the run's end state: nothing to answer, the run is over
         if tick.tick == last_tick and last_out is not None:
             publish_output(bus.publish, last_out)  # a re-sent tick: the same answer
             continue

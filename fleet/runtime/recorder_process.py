@@ -4,8 +4,8 @@ It subscribes to everything under the run prefix before tick 0 (the world
 waits for its liveliness token), stores valid payloads without re-encoding
 them at their simulated time (invalid ones are counted by the bus; the
 counts, if any, go into the ``result`` metadata as ``invalid_messages``; a message
-sent again after a lost link is stored once), and ends when the world ended the run
-and left: it then writes the run's result (from ``world/result``) and the footer. A
+sent again after a lost link is stored once), and ends on the run's last message,
+``world/result``: it then writes the run's result (from ``world/result``) and the footer. A
 world gone without a result leaves a file without one. If it is killed, the
 completed chunks stay readable (see recordings.writer).
 """
@@ -52,8 +52,7 @@ def serve_recorder(
                 received = messages.get(timeout=POLL_S)
             except queue.Empty:
                 writer.flush_if_due()
-                if world.over(result is not None, at):
-                    break
+                world.check(at)
                 continue
             if last.get(received.key) == received.payload:
                 continue  # sent again after a lost link: stored once
@@ -62,8 +61,9 @@ def serve_recorder(
             at = max(at, tick * dt)
             writer.write_payload(received.key, received.payload, tick * dt_ns)
             count += 1
-            if received.key == keys.WORLD_RESULT:
+            if received.key == keys.WORLD_RESULT:  # the run's last message
                 result = _result(received.msg.summary)
+                break
     finally:
         if result is not None:
             if bus.invalid:  # else the same result as a run in process

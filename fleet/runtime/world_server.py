@@ -82,7 +82,23 @@ class WorldServer:
                 elif delay < -self.tick_timeout:  # after a pause: go on at pace, no rush
                     paced_from -= delay
 
-        return run_lockstep(self.world, self._collect, self.bus.publish, after_tick=after_tick)
+        summary = run_lockstep(self.world, self._collect, self.bus.publish, after_tick=after_tick)
+        self._await_departures()
+        return summary
+
+    def _await_departures(self) -> None:
+        """After the final tick and the result: wait (at most ``tick_timeout``) until every
+        AGV and the recorder has left, each on its last message, before the world's token
+        goes. Closing at once can drop a final message still on its way to a large fleet,
+        and its processes would then take the world's departure for a crash."""
+        deadline = time.monotonic() + self.tick_timeout
+        recorder_up = self._recorder is not None
+        while (self.alive or recorder_up) and time.monotonic() < deadline:
+            self._update_liveliness(timeout=POLL_S)
+            if recorder_up:
+                with contextlib.suppress(queue.Empty):
+                    while recorder_up:
+                        recorder_up = self._recorder.get_nowait()[1]
 
     def _wait_for_agvs(self) -> None:
         """Every AGV's token before tick 0 (it is declared after its tick subscriber),

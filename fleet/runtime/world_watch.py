@@ -1,8 +1,8 @@
 """Whether the world is still there, for a process that serves it (an AGV, the recorder).
 
-The world's liveliness token goes when the run ends (after its final tick and
-result) and also when the link to the world is lost. A token that goes before
-the run ended is either: if the world's endpoint now refuses connections,
+An AGV leaves on the run's final tick, the recorder on its result, and the world
+waits for them to leave before its liveliness token goes; so a token that goes
+while one of them still waits means the run did not end for it. Either: if the world's endpoint now refuses connections,
 nothing listens there any more (its process died) and the run is over at once;
 otherwise the link may come back (a Zenoh client reconnects by itself) and the
 process waits up to the grace period, as the world waits for it.
@@ -39,10 +39,10 @@ class WorldWatch:
         self._lost_since: float | None = None
         self._probed = 0.0
 
-    def over(self, ended: bool, at: float) -> bool:
-        """Call when no message is waiting: True once the world ended the run (``ended``:
-        its final message came) and left. Raises WorldGone when it left without ending it
-        (``at``: the simulated time reached) or never came."""
+    def check(self, at: float) -> None:
+        """Call when no message is waiting. The run's last message ends a caller's loop
+        before the world leaves, so a world that left raises WorldGone: without ending the
+        run (``at``: the simulated time reached), or it never came."""
         try:
             while True:
                 _, alive = self._tokens.get_nowait()
@@ -57,11 +57,9 @@ class WorldWatch:
         if not self._seen:
             if now - self._started > self.start_timeout:
                 raise WorldGone(f"no world appeared within {self.start_timeout:g} s")
-            return False
+            return
         if self._lost_since is None:
-            return False
-        if ended:
-            return True
+            return
         if now - self._probed > PROBE_EVERY_S:
             self._probed = now
             if refuses(self.endpoint):
@@ -71,4 +69,3 @@ class WorldWatch:
                 )
         if now - self._lost_since > self.grace:
             raise WorldGone(f"lost the world at t = {at:.1f} s for more than {self.grace:g} s")
-        return False
