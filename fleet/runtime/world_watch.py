@@ -2,10 +2,11 @@
 
 An AGV leaves on the run's final tick, the recorder on its result, and the world
 waits for them to leave before its liveliness token goes; so a token that goes
-while one of them still waits means the run did not end for it. Either: if the world's endpoint now refuses connections,
-nothing listens there any more (its process died) and the run is over at once;
-otherwise the link may come back (a Zenoh client reconnects by itself) and the
-process waits up to the grace period, as the world waits for it.
+while one of them still waits means the run did not end for it. Either the
+world's endpoint now refuses connections: nothing listens there any more (its
+process died) and the run is over at once; or the link may come back (a Zenoh
+client reconnects by itself) and the process waits up to the grace period, as
+the world waits for it.
 """
 
 from __future__ import annotations
