@@ -118,6 +118,14 @@ def plan_global(
     return _plan_paper(grid, start, goal, algorithm, clearance.safety_distance, corner_cutting)
 
 
+def _no_path(algorithm, start, goal, expansions: int, t0: float, profile: str) -> PlanResult:
+    """The result of a search that found no path (timed from ``t0``)."""
+    elapsed = time.perf_counter() - t0
+    return PlanResult(
+        algorithm, start, goal, False, expansions=expansions, time_s=elapsed, profile=profile
+    )
+
+
 def _plan_paper(grid, start, goal, algorithm, safety_distance, corner_cutting) -> PlanResult:
     start_cell = grid.free_cell_of(start, "start")
     goal_cell = grid.free_cell_of(goal, "goal")
@@ -130,15 +138,7 @@ def _plan_paper(grid, start, goal, algorithm, safety_distance, corner_cutting) -
         corner_cutting=corner_cutting,
     )
     if not result.found:
-        return PlanResult(
-            algorithm,
-            start,
-            goal,
-            False,
-            expansions=result.expansions,
-            time_s=time.perf_counter() - t0,
-            profile=PAPER,
-        )
+        return _no_path(algorithm, start, goal, result.expansions, t0, PAPER)
     if algorithm == "improved":
         key_cells = extract_key_nodes(grid, result.cells, safety_distance)
     else:
@@ -170,15 +170,7 @@ def _plan_costmap(grid, start, goal, algorithm, clearance, costmap) -> PlanResul
         raise ValueError("the costmap given is not the costmap of this map and clearance")
     result = search_costmap(costmap, start_cell, goal_cell, improved=algorithm == "improved")
     if not result.found:
-        return PlanResult(
-            algorithm,
-            start,
-            goal,
-            False,
-            expansions=result.expansions,
-            time_s=time.perf_counter() - t0,
-            profile=DEFAULT,
-        )
+        return _no_path(algorithm, start, goal, result.expansions, t0, DEFAULT)
     # the path runs from the exact start through the inner cell centres to the exact goal
     inner = result.cells[1:-1]
     points = np.array(
