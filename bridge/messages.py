@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from planner.agv_status import STATUSES
 from planner.errors import BadInputError
+from planner.traffic import PHASES, Intent
 
 # No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
 # a decoded message is bounded however it was made.
@@ -84,6 +85,7 @@ class AgvCommand:
     plan_time_ms: float = 0.0
     start_heading: float | None = None
     failure: str = ""  # why, when status is "failed"
+    intent: Intent | None = None  # its traffic claim and route ahead (planner/traffic.py)
 
 
 @dataclass
@@ -103,6 +105,8 @@ class Tick:
     """The world's clock: tick k at time t with every AGV and obstacle.
 
     ``final`` marks the last tick of a run: the end state, which nobody answers.
+    ``intents`` are the traffic intents the AGVs sent with their commands for this
+    tick: every AGV decides on the same ones (``planner.traffic``).
     """
 
     tick: int
@@ -111,6 +115,7 @@ class Tick:
     moving: list[ObstacleState] = field(default_factory=list)
     temporary: list[list[int]] = field(default_factory=list)
     final: bool = False
+    intents: list[Intent] = field(default_factory=list)  # every running AGV's, of tick k-1
 
 
 @dataclass
@@ -159,7 +164,11 @@ class ResultMsg:
 
 
 # string fields that take one of a few values
-CHOICES = {(AgvState, "status"): STATUSES, (AgvCommand, "status"): STATUSES}
+CHOICES = {
+    (AgvState, "status"): STATUSES,
+    (AgvCommand, "status"): STATUSES,
+    (Intent, "phase"): PHASES,
+}
 
 MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event, ResultMsg)
 

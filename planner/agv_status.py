@@ -4,7 +4,8 @@ from __future__ import annotations
 
 DRIVING = "driving"
 BLOCKED = "blocked"  # no admissible command this cycle: braking
+WAITING = "waiting"  # holding outside a passage another AGV has (planner/traffic.py)
 ARRIVED = "arrived"
 FAILED = "failed"
-STATUSES = (DRIVING, BLOCKED, ARRIVED, FAILED)
+STATUSES = (DRIVING, BLOCKED, WAITING, ARRIVED, FAILED)
 FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run

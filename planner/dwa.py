@@ -355,17 +355,27 @@ def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarra
     )
 
 
-def steady_choice(score: np.ndarray, change: np.ndarray, tolerance: float) -> int:
-    """The sample of least ``change`` among those scoring within ``tolerance`` of the best.
+def steady_choice(
+    score: np.ndarray, change: np.ndarray, tolerance: float, speed_change: np.ndarray
+) -> int:
+    """The sample of least ``change`` among those scoring within ``tolerance`` of the best
+    that change the speed the way the best does (up, down or not).
 
     ``tolerance`` is a fraction of the scores' spread. The normalised scores
     of neighbouring samples differ by little, so the plain argmax hops
     between them every cycle and the acceleration flips; preferring the
     steadiest near-best sample keeps the acceleration unless a clearly
-    better command exists.
+    better command exists. The speed's direction of change follows the best
+    sample: the speed term's differences are far inside the tolerance, and
+    without it an AGV that had slowed down (at a narrow entrance) kept its
+    crawl through a whole corridor.
     """
     top = float(score.max())
-    near = np.flatnonzero(score >= top - tolerance * (top - float(score.min())))
+    way = np.sign(np.round(speed_change, 9))
+    best_way = way[int(np.argmax(score))]
+    near = np.flatnonzero(
+        (score >= top - tolerance * (top - float(score.min()))) & (way == best_way)
+    )
     return int(near[np.lexsort((-score[near], change[near]))[0]])
 
 
@@ -465,7 +475,8 @@ class DwaPlanner:
         standing = math.hypot(command[0], command[1]) < _EPS
         if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
             change = jerk(commands[ok], command, command if previous is None else previous)
-            best = ok[steady_choice(g, change, self.behaviour.steady_tolerance)]
+            speed_change = np.hypot(commands[ok, 0], commands[ok, 1]) - math.hypot(*command[:2])
+            best = ok[steady_choice(g, change, self.behaviour.steady_tolerance, speed_change)]
         else:
             best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])

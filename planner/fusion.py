@@ -38,12 +38,13 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from planner.agv_status import WAITING
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
-from planner.grid_map import Cell, GridMap, MapError, Point
+from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
 from planner.local_behaviour import local_behaviour
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
@@ -145,6 +146,8 @@ class FusionController:
         self._last_stall = -math.inf  # sim time of the last stall
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
+        self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
+        self._parked_in_way = False  # one of them is on the route: replan
 
     # --- planning -----------------------------------------------------------------
     def start(
@@ -167,9 +170,11 @@ class FusionController:
             self._planned_at = position
             return None
         if self.costmap is not None:
-            known = self.costmap.grid
+            costmap = self.costmap.with_blocked(self.parked) if self.parked else self.costmap
+            known = costmap.grid
         else:
             known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
+            costmap = None
         try:
             plan = plan_global(
                 known,
@@ -178,13 +183,14 @@ class FusionController:
                 _GLOBAL_ALGORITHM[self.config.algorithm],
                 profile=self.config.profile,
                 clearance=self.config.clearance,
-                costmap=self.costmap,
+                costmap=costmap,
             )
         except MapError as err:  # e.g. standing in a cell now known to be blocked
             plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
             self.failure = str(err)
         if not plan.found:
-            self.failure = self.failure or "no path to the goal on the known map"
+            parked = " and the AGVs stopped for good" if self.parked else ""
+            self.failure = self.failure or f"no path to the goal on the known map{parked}"
             self.status = "failed"
             self.targets = []
             return plan
@@ -215,14 +221,16 @@ class FusionController:
         command: tuple[float, float, float],
         now: float,
         moving: np.ndarray | None = None,
+        hold: Point | None = None,
     ) -> ControlStep:
-        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]."""
+        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius];
+        ``hold``: wait there (the traffic rule keeps the AGV out of a passage)."""
         t0 = time.perf_counter()
-        out = self._step(pose, command, now, moving)
+        out = self._step(pose, command, now, moving, hold)
         self._previous = command
         return replace(out, plan_time_s=time.perf_counter() - t0)
 
-    def _step(self, pose, command, now, moving) -> ControlStep:
+    def _step(self, pose, command, now, moving, hold=None) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
         if self.status in ("arrived", "failed"):
             return _step(stop, self.status)
@@ -242,8 +250,13 @@ class FusionController:
             return _step(cmd, "blocked", self.targets[self.target_index])
         self._recovery = None
         plan = self._check_route(position) if self.behaviour.route_check else None
+        if plan is None and self._parked_in_way:  # an AGV stopped for good on the route
+            self._parked_in_way = False
+            plan = self.replan(position)
         if self.status == "failed":
             return _step(stop, self.status, plan=plan)
+        if hold is not None:
+            return self._hold(pose, command, now, moving, hold, plan)
         if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
             plan = self._on_stall(position, now)
             if self.status == "failed":
@@ -265,6 +278,54 @@ class FusionController:
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
+
+    def _hold(self, pose, command, now, moving, hold: Point, plan) -> ControlStep:
+        """Drive to ``hold`` and wait there; waiting is not a stall (no recoveries)."""
+        self._best_time = now
+        self._best_remaining = min(self._best_remaining, self.remaining(pose[:2]))
+        self.status = WAITING
+        position = (pose[0], pose[1])
+        if math.dist(position, hold) <= self.config.goal_tolerance:  # there: stand
+            return _step(braking_command(self.config.dwa, command), WAITING, hold, plan=plan)
+        result = self.dwa.plan(
+            pose, command, hold, moving, reach=self.config.goal_tolerance, stop=True,
+            previous=self._previous, approach=True, segment=(position, hold),
+        )  # fmt: skip
+        return _step(result.command, WAITING, hold, result.trajectory, plan)
+
+    def replan(self, position: Point) -> PlanResult | None:
+        """A new global route from ``position`` (the traffic rule moved the AGV off its
+        route); the progress measure restarts from it."""
+        plan = self._plan_from(position)
+        self._best_remaining = self.remaining(position) if self.targets else math.inf
+        return plan
+
+    def stalled(self, now: float) -> bool:
+        """No progress along the route for the progress window (waiting excluded)."""
+        return now - self._best_time >= self.config.progress_window
+
+    def route_ahead(self) -> list[Point]:
+        """The rest of the route: from the start of the current segment, the targets
+        still ahead."""
+        return self._route_from_segment()
+
+    def _route_from_segment(self) -> list[Point]:
+        return [self._segment_start(), *self.targets[self.target_index :]]
+
+    def park(self, discs) -> None:
+        """AGVs that stopped for good (arrived, failed) at (x, y, radius): obstacles for
+        every later global plan (DWA sees them as discs anyway)."""
+        if self.costmap is None:
+            return
+        cells = set()
+        for x, y, radius in discs:
+            cells |= cells_in_disc(self.grid, (x, y), radius)
+        self.parked = cells - self.known_cells
+        reach = self.config.clearance.radius
+        self._parked_in_way = any(
+            self.targets and _route_distance(self._route_from_segment(), (x, y)) < radius + reach
+            for x, y, radius in discs
+        )
 
     def _segment_start(self) -> Point:
         """Where the route's current segment starts: the previous key node, or where the
@@ -343,3 +404,15 @@ class FusionController:
                 self._recoveries_done = 0
             return False
         return now - self._best_time >= self.config.progress_window
+
+
+def _route_distance(route: list[Point], point: Point) -> float:
+    """Least distance from a point to a polyline."""
+    best = math.inf
+    px, py = point
+    for (ax, ay), (bx, by) in itertools.pairwise(route):
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        t = 0.0 if length2 == 0 else min(max(((px - ax) * dx + (py - ay) * dy) / length2, 0), 1)
+        best = min(best, math.hypot(ax + t * dx - px, ay + t * dy - py))
+    return best

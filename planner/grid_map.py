@@ -179,3 +179,18 @@ def obstacle_prefix_sums(blocked: np.ndarray) -> np.ndarray:
     prefix = np.zeros((blocked.shape[0] + 1, blocked.shape[1] + 1), dtype=np.int64)
     prefix[1:, 1:] = np.cumsum(np.cumsum(blocked, axis=0, dtype=np.int64), axis=1)
     return prefix
+
+
+def cells_in_disc(grid: GridMap, centre: Point, radius: float) -> set[Cell]:
+    """The cells of ``grid`` whose square a disc overlaps (an AGV body as obstacle cells)."""
+    col0, row0 = grid.cell_of((centre[0] - radius, centre[1] - radius))
+    col1, row1 = grid.cell_of((centre[0] + radius, centre[1] + radius))
+    res, (ox, oy) = grid.resolution, grid.origin
+    cells = set()
+    for col in range(max(col0, 0), min(col1, grid.width - 1) + 1):
+        for row in range(max(row0, 0), min(row1, grid.height - 1) + 1):
+            nx = min(max(centre[0], ox + col * res), ox + (col + 1) * res)
+            ny = min(max(centre[1], oy + row * res), oy + (row + 1) * res)
+            if math.hypot(nx - centre[0], ny - centre[1]) < radius:
+                cells.add((col, row))
+    return cells

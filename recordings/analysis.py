@@ -20,6 +20,9 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
   surface, as the world measures it (<= 0 is a contact).
 - collisions: ``collision`` events; planning time: ``plan_time_ms`` of each
   control cycle of the drive (mean, 95th percentile).
+- traffic: waiting time, the ticks an AGV reports ``waiting`` (held outside a
+  passage by the traffic rule) times dt; waits, the ``wait`` events naming it
+  first; the run's traffic events, every ``wait``, ``go`` and ``yield`` event.
 """
 
 from __future__ import annotations
@@ -27,15 +30,16 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
 from planner import path_metrics
-from planner.agv_status import FINISHED
+from planner.agv_status import FINISHED, WAITING
 from planner.distance_field import DistanceField
 from planner.fusion import GLOBAL_ALGORITHM
 from planner.motion import world_velocity
+from planner.traffic import DECISIONS, WAIT
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
 
@@ -61,6 +65,8 @@ class AgvAnalysis:
     collisions: int
     plan_time_mean_ms: float | None
     plan_time_p95_ms: float | None
+    waiting_time: float = 0.0  # s held outside passages
+    waits: int = 0  # times it was held
 
 
 @dataclass(frozen=True)
@@ -91,6 +97,8 @@ class RunAnalysis:
     plan_time_mean_ms: float | None  # over every control cycle of every AGV
     plan_time_p95_ms: float | None
     agvs: tuple[AgvAnalysis, ...]
+    waiting_time: float = 0.0  # s, summed over AGVs
+    traffic_events: int = 0  # wait, go and yield events
 
     @property
     def label(self) -> str:
@@ -127,11 +135,13 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
     obstacle_gap, agv_gap = _clearances(series)
     collisions = [e for e in series.events if e.get("kind") == "collision"]
     hits = Counter(n for e in collisions for n in e.get("agvs", []))
+    traffic = [e for e in series.events if e.get("kind") in DECISIONS]
+    waits = Counter(e["agvs"][0] for e in traffic if e.get("kind") == WAIT and e.get("agvs"))
     agvs, cycles = [], []
     for i, name in enumerate(series.agvs.names):
         clearance = (_finite(obstacle_gap[i]), _finite(agv_gap[i]))
         agv, plan_times = _agv(series, i, dt, statuses.get(name), hits[name], clearance)
-        agvs.append(agv)
+        agvs.append(replace(agv, waits=waits[name]))
         cycles.append(plan_times)
     plan_times = np.concatenate(cycles) if cycles else np.zeros(0)
     run = rec.run
@@ -162,6 +172,8 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         plan_time_mean_ms=float(plan_times.mean()) if len(plan_times) else None,
         plan_time_p95_ms=float(np.percentile(plan_times, 95)) if len(plan_times) else None,
         agvs=tuple(agvs),
+        waiting_time=sum(a.waiting_time for a in agvs),
+        traffic_events=len(traffic),
     )
 
 
@@ -198,6 +210,7 @@ def _agv(
         collisions=collisions,
         plan_time_mean_ms=float(plan_times.mean()) if len(plan_times) else None,
         plan_time_p95_ms=float(np.percentile(plan_times, 95)) if len(plan_times) else None,
+        waiting_time=float((status == WAITING).sum() * dt) if dt else 0.0,
     )
     return agv, plan_times
 
@@ -324,6 +337,8 @@ COMPARED = (
     ("min_clearance_obstacles", "min clearance obstacles", "m"),
     ("min_clearance_agvs", "min clearance AGVs", "m"),
     ("replans", "replans", ""),
+    ("waiting_time", "waiting time", "s"),
+    ("traffic_events", "traffic events", ""),
     ("plan_time_mean_ms", "plan time mean", "ms"),
     ("plan_time_p95_ms", "plan time p95", "ms"),
 )

@@ -28,6 +28,8 @@ AGV_COLUMNS = (
     ("obstacle", "gap m", "min_clearance_obstacles", "{:.2f}", True),
     ("AGV", "gap m", "min_clearance_agvs", "{:.2f}", True),
     ("collisions", "", "collisions", "{}", True),
+    ("waiting", "s", "waiting_time", "{:.1f}", True),
+    ("waits", "", "waits", "{}", False),
     ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
     ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
 )

@@ -17,10 +17,11 @@ import numpy as np
 from bridge import keys
 from bridge.messages import AgvCommand, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
-from planner.agv_status import FAILED
+from planner.agv_status import FAILED, FINISHED
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
 from planner.motion import world_velocity
+from planner.traffic_guard import TrafficGuard
 
 
 @dataclass
@@ -49,6 +50,8 @@ class AgvNode:
         self.spec = scenario.agv(name)
         self.name = name
         self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
+        self.guard = traffic_guard(self.controller)
+        self._parked: frozenset[str] = frozenset()
         self._started = False
 
     def warm_up(self) -> None:
@@ -75,13 +78,27 @@ class AgvNode:
             if pose[2] != me.theta:
                 start_heading = float(pose[2])
         self._sense(tick, pose)
-        step = self.controller.step(pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick))
+        self._park(tick)
+        decision = None
+        if self.guard is not None and self.controller.targets:
+            route = self.controller.route_ahead()
+            stalled = self.controller.stalled(tick.time)
+            decision = self.guard.decide(
+                self.name, tick.tick, (me.x, me.y), route, tick.intents, stalled
+            )
+            if decision.rejoin:  # it waited off its route: plan the way in from here
+                plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), "traffic")
+        step = self.controller.step(
+            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick),
+            hold=decision.hold if decision else None,
+        )  # fmt: skip
         if step.plan is not None:
             plan_msg = self._plan_msg(tick, step.plan, "replan")
         command = self._command(tick, step.command, step.status, step.target)
         command.plan_time_ms = step.plan_time_s * 1e3
         command.start_heading = start_heading
         command.failure = self.controller.failure if step.status == FAILED else ""
+        command.intent = decision.intent if decision else None
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(
@@ -99,6 +116,14 @@ class AgvNode:
             status=status,
             target=list(target) if target is not None else None,
         )
+
+    def _park(self, tick: Tick) -> None:
+        """Tell the planner of AGVs that stopped for good (arrived or failed)."""
+        parked = [s for s in tick.agvs if s.status in FINISHED and s.name != self.name]
+        names = frozenset(s.name for s in parked)
+        if names != self._parked:
+            self._parked = names
+            self.controller.park([(s.x, s.y, s.radius) for s in parked])
 
     def _sense(self, tick: Tick, pose) -> None:
         if not tick.temporary:
@@ -128,6 +153,14 @@ class AgvNode:
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
+
+
+def traffic_guard(controller: FusionController) -> TrafficGuard | None:
+    """The traffic guard of an AGV of the default profile that follows a global route
+    (the paper profile treats other AGVs only as moving discs, as the paper does)."""
+    if controller.costmap is None or controller.config.algorithm == "dwa":
+        return None
+    return TrafficGuard(controller.costmap, controller.config.dwa)
 
 
 def plan_message(name: str, tick: Tick | None, plan: PlanResult, reason: str) -> PlanMsg:

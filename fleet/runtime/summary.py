@@ -25,6 +25,7 @@ class AgvSummary:
     route_length: float | None = None  # m, the AGV's first global route (None: no route)
     clipped: int = 0  # commands the world clipped to the AGV's limits
     refused: int = 0  # reports the world did not believe
+    waiting_time: float = 0.0  # s waiting outside passages other AGVs had
 
 
 @dataclass(frozen=True)
@@ -61,6 +62,7 @@ class RunSummary:
                     "min_clearance": round(a.min_clearance, 4)
                     if math.isfinite(a.min_clearance)
                     else None,
+                    "waiting_time": round(a.waiting_time, 3),
                     **({"failure": a.failure} if a.failure else {}),
                     **({"clipped_commands": a.clipped} if a.clipped else {}),
                     **({"refused_reports": a.refused} if a.refused else {}),
@@ -115,6 +117,7 @@ def summarize(world: World, wall_time: float) -> RunSummary:
                 route_length(world.scenario, name),
                 r.clipped,
                 r.refused,
+                r.waiting_time,
             )
         )
     return RunSummary(

@@ -15,13 +15,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
+from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
-from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED
+from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED, WAITING
 from planner.distance_field import DistanceField
 from planner.dwa import step_pose
 from planner.grid_map import GridMap
 from planner.motion import limit_command
 from planner.profiles import PAPER
+from planner.traffic import Intent
+from planner.traffic_guard import ROUTE_POINTS
 
 
 @dataclass
@@ -37,6 +40,7 @@ class AgvRecord:
     failure: str = ""
     clipped: int = 0  # commands beyond the AGV's limits, clipped by the world
     refused: int = 0  # reports the world did not believe (an arrival away from the goal)
+    waiting_time: float = 0.0  # s spent waiting outside a passage (planner/traffic.py)
 
 
 class World:
@@ -61,6 +65,7 @@ class World:
             for a in scenario.agvs
         }
         self.events: list[Event] = []
+        self.intents: dict[str, Intent] = {}  # each running AGV's last traffic intent
         self.collisions = 0
         self._contacts: set[frozenset[str]] = set()
         self._temporary_shown: list[list[int]] = []
@@ -133,12 +138,27 @@ class World:
                     )
         x, y, theta = step_pose(pose, velocity, self.dt)
         record.distance += math.hypot(x - old.x, y - old.y)
+        if status == WAITING:
+            record.waiting_time += self.dt
+        self._take_intent(name, command.intent, status)
         self.states[name] = AgvState(
             name, self.tick, x, y, theta, *velocity, old.radius, status,
             command.target, command.plan_time_ms, command.failure if status == FAILED else "",
         )  # fmt: skip
         if status in FINISHED and record.status not in FINISHED:
             self._finish(name, status, command.failure or status)
+
+    def _take_intent(self, name: str, intent: Intent | None, status: str) -> None:
+        """Keep a running AGV's intent for the next tick (its own name only) and make its
+        traffic decisions events; a finished AGV's claim ends with it."""
+        if status in FINISHED or intent is None or intent.name != name:
+            self.intents.pop(name, None)
+            return
+        intent.tick = self.tick
+        intent.route = intent.route[:ROUTE_POINTS]  # the tick carries every AGV's: bounded
+        intent.waits_for = [n for n in intent.waits_for[: len(self.records)] if n in self.records]
+        self.events.extend(traffic_events(self.intents.get(name), intent, self.tick, self.time))
+        self.intents[name] = intent
 
     def _refuse(self, name: str, what: str) -> None:
         """A report the world does not believe: counted, and an event the first time."""
@@ -160,6 +180,7 @@ class World:
         state = self.states[name]
         state.vx = state.vy = state.omega = 0.0
         state.status = FAILED
+        self.intents.pop(name, None)
         self._finish(name, FAILED, why)
 
     def drain_events(self) -> list[Event]:
@@ -195,6 +216,7 @@ class World:
             agvs=[AgvState(**vars(s)) for s in self.states.values()],
             moving=self.moving_obstacles(),
             temporary=[list(c) for c in self._temporary_shown],
+            intents=[self.intents[n] for n in self.states if n in self.intents],
         )
 
     def moving_obstacles(self) -> list[ObstacleState]:

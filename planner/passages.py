@@ -1,0 +1,312 @@
+"""Passages: where two AGVs cannot pass each other, found from the costmap.
+
+A *two-lane* place is one where the free space is at least two AGVs plus one margin
+wide (4 r + m): two bodies fit side by side with room between them. It is found from
+the exact distance to obstacle squares on a lattice of half cells (so that a corridor
+of an even number of cells, whose midline lies on a cell edge, is measured within a
+quarter cell): a cell is two-lane when one of its four half cells is at least 2 r + m/2
+from every obstacle square.
+
+A *passage* cell is a cell the AGV fits in (not lethal in the costmap) from which no
+two-lane cell is within 2 r + m/2: inside a corridor, a door, an aisle end or a dock
+too narrow for two. Connected passage cells form a passage; two passages closer than
+one waiting place (``WAIT_ROOM`` times the safety distance, measured through free
+space) are one passage, so that an AGV never has to wait between two of them where
+it would block both. A passage's *mouths* are the clusters of free cells outside it
+that touch it: a corridor has two, a dock one, a crossing of corridors four.
+
+Nothing is hand-marked: the map, the AGV's radius and margin decide. Built once per
+map and clearance and cached with the map, like the costmap.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from planner.costmap import Costmap, centre_distances
+from planner.distance_field import _squared_edt
+from planner.grid_map import GridMap, Point
+
+WAIT_ROOM = 2.0
+"""Passages closer than this many safety distances (through free space) are one."""
+
+NONE = -1
+"""Label of a cell outside every passage / mouth."""
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """Where a route goes through a passage: entered ``enter_at`` m along the route
+    (0: the route starts inside), left ``leave_at`` m along it through mouth ``exit``
+    (None: the route ends inside, at a goal in a dock or a corridor)."""
+
+    passage: int
+    enter_at: float
+    leave_at: float
+    exit: int | None
+
+
+@dataclass(frozen=True, eq=False)
+class Passages:
+    """The passages of one map for one AGV clearance (see module doc)."""
+
+    grid: GridMap
+    label: np.ndarray  # (H, W) int32: passage id, or NONE
+    mouth: np.ndarray  # (H, W) int32: mouth id (ids unique over the map), or NONE
+    count: int
+    join_distance: float  # m: passages closer than this through free space are one
+    _centres_of: dict = field(default_factory=dict, repr=False)  # passage -> cell centres
+
+    @classmethod
+    def for_costmap(cls, costmap: Costmap) -> Passages:
+        """The passages of the costmap's map, built on first use and cached with it."""
+        key = ("passages", costmap.clearance)
+        passages = costmap.grid.cache.get(key)
+        if passages is None:
+            passages = costmap.grid.cache[key] = cls.build(costmap)
+        return passages
+
+    @classmethod
+    def build(cls, costmap: Costmap) -> Passages:
+        grid, clearance = costmap.grid, costmap.clearance
+        res = grid.resolution
+        lane = 2 * clearance.radius + clearance.margin / 2  # m: half of 4 r + m
+        fine = np.kron(grid.blocked, np.ones((2, 2), dtype=bool))
+        half_cell = centre_distances(fine) * (res / 2)
+        two_lane = half_cell.reshape(grid.height, 2, grid.width, 2).max(axis=(1, 3)) >= lane
+        free = ~costmap.lethal
+        if two_lane.any():
+            to_two_lane = np.sqrt(_squared_edt(two_lane)) * res
+        else:
+            to_two_lane = np.full(two_lane.shape, np.inf)
+        narrow = free & (to_two_lane > lane)
+        join = WAIT_ROOM * clearance.safety_distance
+        label = _label_passages(narrow, free, max(1, math.ceil(join / res)))
+        mouth = _label_mouths(label, free)
+        for array in (label, mouth):
+            array.setflags(write=False)
+        return cls(grid, label, mouth, int(label.max()) + 1, join)
+
+    def at(self, point: Point) -> int:
+        """The passage at a world point, or NONE."""
+        col, row = self.grid.cell_of(point)
+        if not self.grid.contains_cell((col, row)):
+            return NONE
+        return int(self.label[row, col])
+
+    def distance_to(self, point: Point, passage: int) -> float:
+        """Distance (m) from a world point to the nearest cell centre of a passage."""
+        centres = self._centres(passage)
+        return float(np.hypot(centres[:, 0] - point[0], centres[:, 1] - point[1]).min())
+
+    def _centres(self, passage: int) -> np.ndarray:
+        centres = self._centres_of.get(passage)
+        if centres is None:
+            rows, cols = np.nonzero(self.label == passage)
+            res, (ox, oy) = self.grid.resolution, self.grid.origin
+            centres = np.column_stack((ox + (cols + 0.5) * res, oy + (rows + 0.5) * res))
+            self._centres_of[passage] = centres
+        return centres
+
+    def first_crossing(
+        self, route: list[Point], lookahead: float, start_at: float = 0.0
+    ) -> Crossing | None:
+        """The first passage ``route`` (a polyline, world frame) enters between
+        ``start_at`` and ``start_at + lookahead`` metres along it, or None; distances in
+        the result are from ``start_at``. Where the route leaves the passage (its last
+        sample inside before a stretch longer than a waiting place outside) is found on
+        the whole route."""
+        points, along = _samples(route, self.grid.resolution / 2)
+        ahead = along >= start_at - self.grid.resolution / 2
+        points, along = points[ahead], np.maximum(along[ahead] - start_at, 0.0)
+        if not len(points):
+            return None
+        res = self.grid.resolution
+        cols = np.floor((points[:, 0] - self.grid.origin[0]) / res).astype(np.int64)
+        rows = np.floor((points[:, 1] - self.grid.origin[1]) / res).astype(np.int64)
+        inside = (cols >= 0) & (cols < self.grid.width) & (rows >= 0) & (rows < self.grid.height)
+        labels = np.full(len(points), NONE)
+        labels[inside] = self.label[rows[inside], cols[inside]]
+        hits = np.flatnonzero(labels != NONE)
+        if not len(hits) or along[hits[0]] > lookahead:
+            return None
+        first = int(hits[0])
+        passage = int(labels[first])
+        mine = np.flatnonzero(labels == passage)
+        gaps = np.flatnonzero(np.diff(along[mine]) > self.join_distance)
+        last = int(mine[gaps[0]] if len(gaps) else mine[-1])
+        exit = None
+        if last + 1 < len(points) and inside[last + 1]:
+            exit = self._mouth_near(int(cols[last + 1]), int(rows[last + 1]), passage)
+        return Crossing(passage, float(along[first]), float(along[last]), exit)
+
+    def _mouth_near(self, col: int, row: int, passage: int) -> int | None:
+        """The mouth of ``passage`` at or next to a cell (routes sample in half cells)."""
+        for dc, dr in (
+            (0, 0),
+            (1, 0),
+            (-1, 0),
+            (0, 1),
+            (0, -1),
+            (1, 1),
+            (-1, -1),
+            (1, -1),
+            (-1, 1),
+        ):
+            c, r = col + dc, row + dr
+            inside = self.grid.contains_cell((c, r))
+            if inside and self.mouth[r, c] != NONE and _touches(self.label, c, r, passage):
+                return int(self.mouth[r, c])
+        return None
+
+
+def _samples(route: list[Point], step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Points at most ``step`` m apart along a polyline (its vertices included), and
+    their distance along it."""
+    vertices = np.asarray(route, dtype=float).reshape(-1, 2)
+    if len(vertices) < 2:
+        return vertices, np.zeros(len(vertices))
+    lengths = np.hypot(*np.diff(vertices, axis=0).T)
+    counts = np.maximum(1, np.ceil(lengths / step).astype(np.int64))
+    segment = np.repeat(np.arange(len(lengths)), counts)
+    t = (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)) / counts[segment]
+    a, b = vertices[segment], vertices[segment + 1]
+    points = np.vstack((a + (b - a) * t[:, None], vertices[-1:]))
+    starts = np.concatenate(([0.0], np.cumsum(lengths)))
+    along = np.concatenate((starts[segment] + lengths[segment] * t, starts[-1:]))
+    return points, along
+
+
+def _touches(label: np.ndarray, col: int, row: int, passage: int) -> bool:
+    height, width = label.shape
+    for dr in (-1, 0, 1):
+        for dc in (-1, 0, 1):
+            r, c = row + dr, col + dc
+            if 0 <= r < height and 0 <= c < width and label[r, c] == passage:
+                return True
+    return False
+
+
+@numba.njit(cache=True)
+def _find(parent, i):
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@numba.njit(cache=True)
+def _label_passages(narrow, free, room):
+    """Passage ids: 8-connected narrow cells, joined when their components come within
+    ``room`` steps of each other through free cells; ids numbered in row-major order."""
+    height, width = narrow.shape
+    component = np.full((height, width), -1, dtype=np.int32)
+    count = 0
+    queue = np.empty(height * width * 2, dtype=np.int64)
+    for r0 in range(height):
+        for c0 in range(width):
+            if not narrow[r0, c0] or component[r0, c0] >= 0:
+                continue
+            head, tail = 0, 0
+            queue[tail] = r0 * width + c0
+            tail += 1
+            component[r0, c0] = count
+            while head < tail:
+                r, c = divmod(queue[head], width)
+                head += 1
+                for dr in (-1, 0, 1):
+                    for dc in (-1, 0, 1):
+                        rr, cc = r + dr, c + dc
+                        inside = 0 <= rr < height and 0 <= cc < width
+                        if inside and narrow[rr, cc] and component[rr, cc] < 0:
+                            component[rr, cc] = count
+                            queue[tail] = rr * width + cc
+                            tail += 1
+            count += 1
+    parent = np.arange(max(count, 1))
+    # grow every component through free cells, at most ``room`` steps; fronts that meet
+    # join their components
+    owner = component.copy()
+    steps = np.full((height, width), -1, dtype=np.int64)
+    head, tail = 0, 0
+    for r in range(height):
+        for c in range(width):
+            if owner[r, c] >= 0:
+                steps[r, c] = 0
+                queue[tail] = r * width + c
+                tail += 1
+    while head < tail:
+        r, c = divmod(queue[head], width)
+        head += 1
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                rr, cc = r + dr, c + dc
+                if not (0 <= rr < height and 0 <= cc < width) or not free[rr, cc]:
+                    continue
+                if owner[rr, cc] >= 0:
+                    a, b = _find(parent, owner[r, c]), _find(parent, owner[rr, cc])
+                    if a != b:
+                        parent[max(a, b)] = min(a, b)
+                elif steps[r, c] < room:
+                    owner[rr, cc] = owner[r, c]
+                    steps[rr, cc] = steps[r, c] + 1
+                    queue[tail] = rr * width + cc
+                    tail += 1
+    label = np.full((height, width), -1, dtype=np.int32)
+    ids = np.full(max(count, 1), -1, dtype=np.int32)
+    next_id = 0
+    for r in range(height):
+        for c in range(width):
+            if component[r, c] >= 0:
+                root = _find(parent, component[r, c])
+                if ids[root] < 0:
+                    ids[root] = next_id
+                    next_id += 1
+                label[r, c] = ids[root]
+    return label
+
+
+@numba.njit(cache=True)
+def _label_mouths(label, free):
+    """Mouth ids: 8-connected clusters of free cells outside every passage that touch
+    one passage (a cluster never spans two passages: those are at least a waiting
+    place apart, or one)."""
+    height, width = label.shape
+    touching = np.full((height, width), -1, dtype=np.int32)
+    for r in range(height):
+        for c in range(width):
+            if label[r, c] >= 0 or not free[r, c]:
+                continue
+            for dr in (-1, 0, 1):
+                for dc in (-1, 0, 1):
+                    rr, cc = r + dr, c + dc
+                    if 0 <= rr < height and 0 <= cc < width and label[rr, cc] >= 0:
+                        touching[r, c] = label[rr, cc]
+    mouth = np.full((height, width), -1, dtype=np.int32)
+    queue = np.empty(height * width, dtype=np.int64)
+    count = 0
+    for r0 in range(height):
+        for c0 in range(width):
+            if touching[r0, c0] < 0 or mouth[r0, c0] >= 0:
+                continue
+            head, tail = 0, 0
+            queue[tail] = r0 * width + c0
+            tail += 1
+            mouth[r0, c0] = count
+            while head < tail:
+                r, c = divmod(queue[head], width)
+                head += 1
+                for dr in (-1, 0, 1):
+                    for dc in (-1, 0, 1):
+                        rr, cc = r + dr, c + dc
+                        inside = 0 <= rr < height and 0 <= cc < width
+                        if inside and mouth[rr, cc] < 0 and touching[rr, cc] == touching[r0, c0]:
+                            mouth[rr, cc] = count
+                            queue[tail] = rr * width + cc
+                            tail += 1
+            count += 1
+    return mouth

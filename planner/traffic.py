@@ -1,0 +1,114 @@
+"""The traffic rule: who may enter a passage, decided the same way by every AGV.
+
+Zone control as industrial AGV fleets use it (blocking sections), with the sections
+found from the map (``planner.passages``) and a first-come order. Every AGV publishes
+an :class:`Intent` with its command; the world hands all of them out with the next
+tick, so at tick k every AGV applies :func:`may_enter` to the *same* intents (those of
+tick k-1) and they all reach the same decision without negotiating. That is what
+makes the decisions identical in process and over Zenoh.
+
+The rule, for an AGV whose route enters passage P within its request distance:
+
+1. P is *held* by the AGVs inside it (phase ``go``). An AGV may join the holders only
+   if it leaves P through the same mouth as all of them: a convoy in one direction.
+2. Otherwise the requesters of P queue by the tick they first asked (``since``), then
+   by name. From the head of the queue, every requester that leaves through the same
+   mouth as the head may enter; the queue stops at the first one that does not
+   (first come, first served, so nobody waits for ever behind a convoy).
+3. An AGV that may not enter waits (phase ``wait``) at a place outside P, off its route
+   (``planner.traffic_guard``). Holders never wait for a passage while inside one
+   (the first passage on a route is the one it is in), and passages closer than one
+   waiting place are one passage, so waiting AGVs never wait for each other in a
+   cycle; a holder that cannot move (blocked by a body) is the remaining deadlock, and
+   ``stalled`` intents let the waiters see it and give way.
+
+An AGV whose route ends inside P (a goal in a dock) leaves it through no mouth
+(``exit`` None): it goes alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+CLEAR = "clear"  # no passage within the request distance
+REQUEST = "request"  # asking for a passage, not yet answered (first tick of a request)
+WAIT = "wait"  # asked, not allowed yet: waiting outside the passage
+GO = "go"  # allowed in, or inside: holds the passage
+YIELD = "yield"  # waiting, and moved further back: a holder cannot move
+PHASES = (CLEAR, REQUEST, WAIT, GO, YIELD)
+DECISIONS = (WAIT, GO, YIELD)
+"""The phases whose start is a traffic decision: a world event of that kind."""
+
+
+@dataclass
+class Intent:
+    """What one AGV tells the fleet each tick: its route ahead and its passage claim.
+
+    ``since`` is the tick it first asked for ``passage``; ``enter_at`` the route
+    distance to it (0 inside); ``exit`` the mouth it leaves by (None: it stops inside);
+    ``stalled`` is true when it has made no progress for its progress window;
+    ``waits_for`` names the AGVs it waits for (phase ``wait``).
+    """
+
+    name: str
+    tick: int
+    phase: str = CLEAR
+    passage: int | None = None
+    exit: int | None = None
+    since: int = 0
+    enter_at: float = 0.0
+    stalled: bool = False
+    route: list[list[float]] = field(default_factory=list)
+    waits_for: list[str] = field(default_factory=list)
+
+
+def holders(passage: int, intents: list[Intent]) -> list[Intent]:
+    """The AGVs inside ``passage`` or allowed in."""
+    return [i for i in intents if i.passage == passage and i.phase == GO]
+
+
+def queue(passage: int, intents: list[Intent]) -> list[Intent]:
+    """The AGVs asking for ``passage``, first come first."""
+    asking = [i for i in intents if i.passage == passage and i.phase in (REQUEST, WAIT, YIELD)]
+    return sorted(asking, key=lambda i: (i.since, i.name))
+
+
+def _same_way(a: Intent, b: Intent) -> bool:
+    return a.exit is not None and a.exit == b.exit
+
+
+def may_enter(name: str, intents: list[Intent]) -> tuple[bool, list[str]]:
+    """Whether AGV ``name`` (whose claim is in ``intents``) may enter its passage now,
+    and if not, whom it waits for."""
+    me = next((i for i in intents if i.name == name), None)
+    if me is None or me.passage is None:
+        return False, []
+    inside = [h for h in holders(me.passage, intents) if h.name != name]
+    against = [h.name for h in inside if not _same_way(h, me)]
+    if against:
+        return False, against
+    order = queue(me.passage, intents)
+    head = inside[0] if inside else (order[0] if order else None)
+    ahead = [h.name for h in inside] or ([head.name] if head else [])
+    for other in order:
+        if other is not head and not _same_way(other, head):
+            return False, ahead if other.name == name else [other.name]
+        if other.name == name:
+            return True, []
+    return False, ahead
+
+
+def waiting_for(intents: list[Intent]) -> dict[str, list[str]]:
+    """The wait-for graph: every waiting AGV and the AGVs it waits for."""
+    graph = {}
+    for intent in intents:
+        if intent.phase in (WAIT, YIELD):
+            allowed, blockers = may_enter(intent.name, intents)
+            if not allowed:
+                graph[intent.name] = blockers
+    return graph
+
+
+def stuck_holders(passage: int, intents: list[Intent]) -> list[str]:
+    """Holders of ``passage`` that report no progress: a body is in their way."""
+    return [h.name for h in holders(passage, intents) if h.stalled]

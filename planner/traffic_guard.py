@@ -1,0 +1,181 @@
+"""One AGV's side of the traffic rule: claim the next passage, wait outside it, or go.
+
+Each tick the guard looks along the AGV's route for the first passage within its
+*request distance* (braking distance at full speed plus a waiting place and a safety
+distance: far enough to stop outside), claims it with the mouth it will leave by,
+and applies ``planner.traffic.may_enter`` to the fleet's intents of the last tick.
+Not allowed: the AGV holds at a *waiting place* ``WAIT_BACK`` safety distances
+before the passage along its route, moved off the route to its right where the
+costmap has room, so that AGVs coming out of the passage pass it. While it waits and
+a holder of the passage reports no progress (a body in its way), the waiting place
+moves back, away from the passage: it yields.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+from planner.costmap import Costmap
+from planner.dwa import DwaConfig
+from planner.grid_map import Point
+from planner.passages import NONE, Crossing, Passages
+from planner.traffic import CLEAR, GO, REQUEST, WAIT, YIELD, Intent, may_enter, stuck_holders
+
+WAIT_BACK = (3.0, 4.0, 6.0)
+"""The waiting place is this many safety distances before the passage along the route
+(the first with room) ..."""
+ASIDE = (2.0, 1.5, 1.0, 0.0)
+"""... and this many safety distances to the right of the route (the first with room):
+AGVs leaving the passage along the route pass it."""
+ROUTE_POINTS = 5
+"""Route points ahead shared in an intent (the AGV's position, then key nodes)."""
+
+
+@dataclass(frozen=True)
+class TrafficDecision:
+    """The guard's answer for one tick: the intent to share, and where to wait (None:
+    drive on)."""
+
+    intent: Intent
+    hold: Point | None
+    rejoin: bool = False  # it waited off its route and may go now: plan from where it is
+
+
+class TrafficGuard:
+    def __init__(self, costmap: Costmap, dwa: DwaConfig):
+        self.costmap = costmap
+        self.passages = Passages.for_costmap(costmap)
+        safety = costmap.clearance.safety_distance
+        braking = dwa.max_speed**2 / (2 * dwa.max_accel)
+        self.request_distance = braking + (max(WAIT_BACK) + 2) * safety
+        self.release_distance = WAIT_BACK[0] * safety
+        self._claim: tuple[int, int | None] | None = None
+        self._since = 0
+        self._phase = CLEAR
+        self._hold: Point | None = None
+
+    def decide(
+        self,
+        name: str,
+        tick: int,
+        position: Point,
+        route: list[Point],
+        intents: list[Intent],
+        stalled: bool,
+    ) -> TrafficDecision:
+        """This tick's claim and waiting place. ``route`` is the rest of the AGV's route
+        from the start of its current segment (the AGV is somewhere along, or beside,
+        that segment); ``intents`` are the fleet's of the last tick (the world's tick
+        carries them)."""
+        shared = [[round(x, 2), round(y, 2)] for x, y in [position, *route[1:ROUTE_POINTS]]]
+        along = _projection(route, position)
+        crossing = self.passages.first_crossing(route, self.request_distance, along)
+        here = self.passages.at(position)
+        if here != NONE and (crossing is None or crossing.passage != here):
+            crossing = Crossing(here, 0.0, 0.0, None)  # inside a passage off the route
+        if self._leaving(position, crossing):
+            crossing = Crossing(self._claim[0], 0.0, 0.0, self._claim[1])
+        if crossing is None:
+            self._claim, self._phase = None, CLEAR
+            return self._decision(Intent(name, tick, CLEAR, stalled=stalled, route=shared))
+        claim = (crossing.passage, crossing.exit)
+        if claim != self._claim:
+            self._claim, self._since, self._phase, self._hold = claim, tick, REQUEST, None
+        intent = Intent(
+            name, tick, self._phase, crossing.passage, crossing.exit, self._since,
+            round(crossing.enter_at, 2), stalled, shared,
+        )  # fmt: skip
+        if crossing.enter_at <= 0.0 or self._phase == GO:
+            intent.phase = self._phase = GO  # inside, or allowed in: holds the passage
+            return self._decision(intent)
+        seen = next((i for i in intents if i.name == name), None)
+        if seen is None or (seen.passage, seen.exit, seen.since) != (*claim, self._since):
+            return self._decision(intent)  # the fleet has not seen this claim yet
+        allowed, blockers = may_enter(name, intents)
+        if allowed:
+            waited = self._phase in (WAIT, YIELD)
+            intent.phase = self._phase = GO
+            return self._decision(intent, rejoin=waited)
+        if self._hold is None:
+            self._hold = self._waiting_place(route, along + crossing.enter_at)
+        if stuck_holders(crossing.passage, intents) and self._phase != YIELD:
+            self._hold = self._further_back(route, along + crossing.enter_at)
+            intent.phase = self._phase = YIELD
+        elif self._phase != YIELD:
+            intent.phase = self._phase = WAIT
+        return self._decision(intent, self._hold, blockers)
+
+    def _leaving(self, position: Point, crossing: Crossing | None) -> bool:
+        """Just out of the passage it held: it keeps it until its body is clear of the
+        mouth (``WAIT_BACK[0]`` safety distances), where the waiting AGVs are not."""
+        if self._phase != GO or self._claim is None:
+            return False
+        if crossing is not None and crossing.passage == self._claim[0]:
+            return False
+        return self.passages.distance_to(position, self._claim[0]) < self.release_distance
+
+    def _decision(self, intent: Intent, hold=None, blockers=(), rejoin=False) -> TrafficDecision:
+        if intent.phase not in (WAIT, YIELD):
+            self._hold = None
+        intent.waits_for = sorted(blockers)
+        return TrafficDecision(intent, hold, rejoin)
+
+    def _waiting_place(self, route: list[Point], enter_at: float) -> Point:
+        """``wait_back`` before the passage (``enter_at`` m along the route), moved to the
+        right of the route where free."""
+        safety = self.costmap.clearance.safety_distance
+        for back in WAIT_BACK:
+            point, heading = _point_along(route, max(0.0, enter_at - back * safety))
+            right = (math.sin(heading), -math.cos(heading))
+            for aside in ASIDE:
+                place = (point[0] + right[0] * aside * safety, point[1] + right[1] * aside * safety)
+                if self._room_at(place) and self._room_at(_midpoint(point, place)):
+                    return place
+        return _point_along(route, max(0.0, enter_at - WAIT_BACK[0] * safety))[0]
+
+    def _further_back(self, route: list[Point], enter_at: float) -> Point:
+        """A waiting place twice as far from the passage, where there is room (a holder
+        is stuck: the waiting AGV may be what blocks it)."""
+        hold = self._hold or self._waiting_place(route, enter_at)
+        entrance, _ = _point_along(route, enter_at)
+        away = (2 * hold[0] - entrance[0], 2 * hold[1] - entrance[1])
+        return away if self._room_at(away) and self._room_at(hold) else hold
+
+    def _room_at(self, point: Point) -> bool:
+        grid = self.costmap.grid
+        cell = grid.cell_of(point)
+        if not grid.contains_cell(cell) or self.passages.label[cell[1], cell[0]] >= 0:
+            return False
+        return self.costmap.distance[cell[1], cell[0]] >= self.costmap.clearance.safety_distance
+
+
+def _point_along(route: list[Point], at: float) -> tuple[Point, float]:
+    """The point ``at`` m along a polyline and the polyline's heading there."""
+    travelled = 0.0
+    for a, b in itertools.pairwise(route):
+        length = math.dist(a, b)
+        if length > 0 and travelled + length >= at:
+            t = (at - travelled) / length
+            heading = math.atan2(b[1] - a[1], b[0] - a[0])
+            return (a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t), heading
+        travelled += length
+    a, b = route[-2] if len(route) > 1 else route[0], route[-1]
+    return tuple(b), math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def _projection(route: list[Point], position: Point) -> float:
+    """How far along the route's first segment the position lies (clamped to it)."""
+    if len(route) < 2:
+        return 0.0
+    (ax, ay), (bx, by) = route[0], route[1]
+    length2 = (bx - ax) ** 2 + (by - ay) ** 2
+    if length2 == 0.0:
+        return 0.0
+    t = ((position[0] - ax) * (bx - ax) + (position[1] - ay) * (by - ay)) / length2
+    return min(max(t, 0.0), 1.0) * math.sqrt(length2)
+
+
+def _midpoint(a: Point, b: Point) -> Point:
+    return ((a[0] + b[0]) / 2, (a[1] + b[1]) / 2)

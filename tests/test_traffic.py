@@ -1,0 +1,158 @@
+"""The traffic layer: passages found from the costmap, the first-come rule, and fleets
+that take turns in passages one AGV wide (in process; over Zenoh in test_fleet_zenoh)."""
+
+from __future__ import annotations
+
+from bridge import keys
+from fleet.runtime.inprocess import run_in_process
+from fleet.scenario import load_scenario, parse_scenario
+from planner.clearance import Clearance
+from planner.costmap import Costmap
+from planner.map_io import parse_text_grid
+from planner.passages import NONE, Passages
+from planner.traffic import GO, REQUEST, WAIT, YIELD, Intent, may_enter, waiting_for
+
+ROOM = "#" + "." * 12 + "#" * 14 + "." * 12 + "#"
+CORRIDOR = "#" + "." * 38 + "#"
+
+
+def two_rooms(corridor_cells: int) -> str:
+    """Two 6 x 2.5 m rooms joined by a 7 m corridor ``corridor_cells`` half-metre cells
+    wide, as text rows top to bottom."""
+    rows = ["#" * 40, *[ROOM] * 5, *[CORRIDOR] * corridor_cells, *[ROOM] * 5, "#" * 40]
+    return "\n".join(rows)
+
+
+def passages_of(text: str, resolution: float = 0.5) -> Passages:
+    grid = parse_text_grid(text, resolution=resolution)
+    return Passages.build(Costmap.build(grid, Clearance()))
+
+
+# --- passages -------------------------------------------------------------------------
+def test_a_corridor_one_agv_wide_is_one_passage_with_a_mouth_at_each_end():
+    passages = passages_of(two_rooms(3))  # 1.5 m: two 0.6 m AGVs cannot pass with margins
+    assert passages.count == 1
+    middle = 3.75  # y of the corridor's midline
+    assert passages.at((10.0, middle)) == 0
+    assert passages.at((3.0, middle)) == NONE and passages.at((17.0, middle)) == NONE
+    mouths = set(passages.mouth[passages.mouth != NONE].tolist())
+    assert len(mouths) == 2
+    east = passages.first_crossing([(2.0, middle), (18.0, middle)], lookahead=30.0)
+    west = passages.first_crossing([(18.0, middle), (2.0, middle)], lookahead=30.0)
+    assert east.passage == west.passage == 0
+    assert east.exit != west.exit and {east.exit, west.exit} == mouths
+    assert 4.0 < east.enter_at < 6.0 and 10.0 < east.leave_at < 12.0  # inside 6.5..13.5 m
+    assert passages.first_crossing([(2.0, middle), (18.0, middle)], lookahead=3.0) is None
+
+
+def test_wide_corridors_and_open_maps_have_no_passages():
+    assert passages_of(two_rooms(4)).count == 0  # 2 m: two AGVs pass
+    for name in ("corridor", "crossing", "warehouse"):  # 2 and 3 m lanes at 1 m cells
+        grid = load_scenario(name).grid
+        assert Passages.build(Costmap.build(grid, Clearance())).count == 0, name
+
+
+def test_a_dock_is_a_passage_with_one_mouth_and_a_route_ending_inside_has_no_exit():
+    rows = ["#" * 20, *["#" + "." * 18 + "#"] * 8, "#" * 9 + "..." + "#" * 8, "#" * 20]
+    rows.insert(10, "#" * 9 + "..." + "#" * 8)
+    rows.insert(10, "#" * 9 + "..." + "#" * 8)
+    passages = passages_of("\n".join(rows))
+    assert passages.count == 1
+    assert len(set(passages.mouth[passages.mouth != NONE].tolist())) == 1
+    into = passages.first_crossing([(5.0, 3.0), (5.25, 3.0), (5.25, 0.8)], lookahead=30.0)
+    assert into is not None and into.exit is None
+
+
+# --- the rule -------------------------------------------------------------------------
+def claim(name, phase, exit, since, passage=0):
+    return Intent(name, 10, phase, passage, exit, since)
+
+
+def test_first_come_first_served_and_ties_go_by_name():
+    intents = [claim("b", WAIT, 1, 5), claim("a", WAIT, 2, 5), claim("c", WAIT, 1, 3)]
+    assert may_enter("c", intents) == (True, [])  # asked first
+    assert may_enter("a", intents) == (False, ["c"])  # the other way: waits for c
+    assert may_enter("b", intents) == (False, ["a"])  # c's way, but a asked before it
+    convoy = [claim("b", WAIT, 1, 5), claim("a", WAIT, 2, 6), claim("c", WAIT, 1, 3)]
+    assert may_enter("b", convoy) == (True, [])  # right behind c, the same way
+    tie = [claim("b", WAIT, 1, 5), claim("a", WAIT, 2, 5)]
+    assert may_enter("a", tie) == (True, []) and may_enter("b", tie) == (False, ["a"])
+
+
+def test_holders_let_in_only_their_own_direction_and_nobody_overtakes_a_waiting_agv():
+    inside = claim("h", GO, 1, 0)
+    assert may_enter("x", [inside, claim("x", WAIT, 2, 1)]) == (False, ["h"])
+    assert may_enter("y", [inside, claim("y", WAIT, 1, 1)]) == (True, [])
+    # an opposite AGV asked before y: y waits behind it even though it goes h's way
+    queue = [inside, claim("x", WAIT, 2, 1), claim("y", REQUEST, 1, 2)]
+    assert may_enter("y", queue) == (False, ["x"])
+    assert waiting_for(queue) == {"x": ["h"]}
+
+
+def test_an_agv_stopping_inside_goes_alone_and_yielding_agvs_still_queue():
+    docked = claim("d", GO, None, 0)
+    assert may_enter("x", [docked, claim("x", WAIT, None, 1)]) == (False, ["d"])
+    backed_off = [claim("x", YIELD, 2, 1), claim("y", WAIT, 1, 2)]
+    assert may_enter("x", backed_off) == (True, [])  # a yielding AGV is not a holder
+    assert may_enter("y", backed_off) == (False, ["x"])
+    assert may_enter("z", backed_off) == (False, [])  # no claim yet
+
+
+# --- fleets ---------------------------------------------------------------------------
+def corridor_swap(cells: int, agvs: list[tuple[str, tuple, tuple]]) -> str:
+    rows = two_rooms(cells)
+    text = [
+        'name = "swap"', "dt = 0.1", "time_limit = 200", "[map]", "resolution = 0.5",
+        f'grid = """\n{rows}\n"""', "[agv_defaults]", "max_speed = 1.0", "max_accel = 0.5",
+        "max_omega = 60", "max_alpha = 120",
+    ]  # fmt: skip
+    for name, start, goal in agvs:
+        heading = 180 if goal[0] < start[0] else 0
+        text += [
+            "[[agvs]]", f'name = "{name}"', f"start = [{start[0]}, {start[1]}]",
+            f"goal = [{goal[0]}, {goal[1]}]", f"heading = {heading}",
+        ]  # fmt: skip
+    return "\n".join(text)
+
+
+def run_with_events(scenario):
+    events = []
+
+    def sink(key, msg):
+        if key == keys.WORLD_EVENT:
+            events.append(msg)
+
+    return run_in_process(scenario, outbox=sink), events
+
+
+def test_mirror_symmetric_agvs_take_turns_in_a_corridor_one_agv_wide():
+    """The paper's method deadlocks here (both drive in and meet head-on); the rule lets
+    the AGV first in the queue (by name, as both asked at once) through first."""
+    mid = 3.75
+    text = corridor_swap(3, [("a", (2.0, mid), (18.0, mid)), ("b", (18.0, mid), (2.0, mid))])
+    summary, events = run_with_events(parse_scenario(text))
+    assert summary.success, summary.table()
+    assert summary.end_reason == "every AGV arrived"
+    by_name = {a.name: a for a in summary.agvs}
+    assert by_name["a"].arrival_time < by_name["b"].arrival_time
+    assert by_name["a"].waiting_time == 0.0 and by_name["b"].waiting_time > 5.0
+    waits = [e for e in events if e.kind == WAIT]
+    goes = [e for e in events if e.kind == GO]
+    assert [e.agvs for e in waits] == [["b", "a"]] and [e.agvs for e in goes] == [["b"]]
+    assert summary.agvs[0].min_clearance > 0 and summary.agvs[1].min_clearance > 0
+
+
+def test_the_paper_profile_has_no_traffic_rule():
+    mid = 3.75
+    text = corridor_swap(3, [("a", (2.0, mid), (18.0, mid)), ("b", (18.0, mid), (2.0, mid))])
+    text = text.replace('name = "swap"', 'name = "swap"\nprofile = "paper"')
+    summary, events = run_with_events(parse_scenario(text.replace("200", "60")))
+    assert not [e for e in events if e.kind in (WAIT, GO)]
+    assert summary.agvs[0].waiting_time == summary.agvs[1].waiting_time == 0.0
+
+
+def test_single_lane_builtin_four_agvs_swap_rooms_without_contact():
+    summary, events = run_with_events(load_scenario("single-lane"))
+    assert summary.success, summary.table()
+    assert any(e.kind == WAIT for e in events)
+    assert sum(a.waiting_time for a in summary.agvs) > 0
