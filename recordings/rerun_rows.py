@@ -9,6 +9,8 @@ Entity paths (everything on the map under ``world``, in world coordinates):
 
     world                         Transform3D, static: shows y up (see ``world_rows``)
     world/map                     Image + Transform3D, static: the grid, one pixel a cell
+    world/passages                Image, static: the passages one AGV wide (traffic rule), for
+                                  the first AGV's radius and the default margin
     world/temporary               Boxes2D: temporary obstacles shown so far
     world/moving                  Points2D discs with labels: moving obstacles
     world/agv/<name>/body         Points2D disc (radius = AGV radius)
@@ -22,9 +24,11 @@ Entity paths (everything on the map under ``world``, in world coordinates):
     world/agv/<name>/plan         LineStrips2D: global path (a replan replaces it)
     world/agv/<name>/plan/key_nodes  Points2D: key nodes
     world/agv/<name>/dwa          LineStrips2D: DWA's chosen trajectory (cleared on arrival)
+    world/agv/<name>/waiting      Points2D: a ring round an AGV the traffic rule holds, labelled
+                                  with whom it waits for (cleared when it goes)
     events/<kind>                 TextLog: one entity per kind of event (the world's events:
-                                  arrived, failed, collision, end, ...; and from the plans:
-                                  replan, no path)
+                                  arrived, failed, collision, end, wait, go, yield, ...; and
+                                  from the plans: replan, no path)
     velocity/<q>/<name>           Scalars, q in vx, vy (body frame), speed (|v|), omega
 """
 
@@ -40,15 +44,22 @@ import rerun as rr
 from bridge import keys
 from bridge.messages import MessageError
 from planner.agv_status import FINISHED
+from planner.clearance import Clearance
+from planner.costmap import Costmap
+from planner.passages import NONE, Passages
+from planner.traffic import WAIT, YIELD
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
 from recordings.palette import agv_color
+from recordings.series import map_grid
 
 TIMELINE = "sim_time"
 WORLD = "world"
 MAP = "world/map"
 TEMPORARY = "world/temporary"
 MOVING = "world/moving"
+PASSAGES = "world/passages"
+PASSAGE_RGBA = (255, 160, 0, 90)  # translucent orange over the map
 EVENTS = "events"
 VELOCITY = "velocity"
 QUANTITIES = ("vx", "vy", "speed", "omega")
@@ -56,6 +67,7 @@ QUANTITIES = ("vx", "vy", "speed", "omega")
 WHITE, GREY, ORANGE, DARK = (230, 230, 230), (160, 160, 160), (255, 160, 0), (20, 20, 20)
 FREE_SHADE, BLOCKED_SHADE = 225, 70  # grey levels of the map image
 LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN"}
+WAITING_RING = 1.6  # x radius: the ring shows round the body
 HEADING_LENGTH = 2.0  # x radius: the heading line sticks out of the disc, visible when small
 LABEL_GAP = 1.0  # m right of the disc's rim: the name (centred on its anchor) never covers it
 
@@ -117,6 +129,8 @@ class RowMaker:
         self._dwa_shown: set[str] = set()
         self._moving_shown = False
         self._temporary: list[list[int]] = []
+        self._map_msg: dict | None = None
+        self._waiting_shown: set[str] = set()
         self._pending = world_rows()
 
     def feed(self, topic: str, data: dict) -> list[Row]:
@@ -154,6 +168,7 @@ class RowMaker:
     def _map(self, data: dict, rows: list[Row]) -> None:
         """The grid as one image, a pixel per cell (filled obstacles, and one image
         whatever the map's size), placed on the world by its transform."""
+        self._map_msg = data
         res = self._resolution = data["resolution"]
         x0, y0 = self._origin = map_origin(data)
         w, h = map_size(data)
@@ -195,6 +210,7 @@ class RowMaker:
                 colors=color, radii=rr.Radius.ui_points(4.0), draw_order=21.0
             ),
             "dwa": rr.LineStrips2D.from_fields(colors=WHITE, radii=thin, draw_order=22.0),
+            "waiting": rr.Points2D.from_fields(colors=ORANGE, show_labels=True, draw_order=29.0),
         }
         for part, style in styles.items():
             rows.append(Row(agv_path(name, part), None, None, [style]))
@@ -205,6 +221,10 @@ class RowMaker:
     # --- temporal ----------------------------------------------------------------
     def _tick(self, data: dict, rows: list[Row]) -> None:
         t = self.end_time = data["time"]
+        if self._map_msg is not None and data["agvs"]:
+            rows.append(_passages(self._map_msg, data["agvs"][0]["radius"]))
+            self._map_msg = None
+        self._waiting(t, data, rows)
         for s in data["agvs"]:
             name = s["name"]
             self._meet(name, rows)
@@ -237,6 +257,24 @@ class RowMaker:
             centers = [[x0 + (c + 0.5) * res, y0 + (r + 0.5) * res] for c, r in self._temporary]
             half = [[res / 2, res / 2]] * len(centers)
             rows.append(Row(TEMPORARY, kinds.boxes, t, (centers, half)))
+
+    def _waiting(self, t: float, data: dict, rows: list[Row]) -> None:
+        """A ring round each AGV the traffic rule holds, labelled with whom it waits for."""
+        held = {
+            i["name"]: i.get("waits_for", [])
+            for i in data.get("intents", [])  # none in recordings before the traffic rule
+            if i["phase"] in (WAIT, YIELD)
+        }
+        for s in data["agvs"]:
+            name = s["name"]
+            if name in held:
+                label = "waits for " + (", ".join(held[name]) or "its turn")
+                ring = ([[s["x"], s["y"]]], [WAITING_RING * s["radius"]], [label])
+                rows.append(Row(agv_path(name, "waiting"), kinds.points, t, ring))
+                self._waiting_shown.add(name)
+            elif name in self._waiting_shown:
+                self._waiting_shown.discard(name)
+                rows.append(Row(agv_path(name, "waiting"), kinds.points, t, ([], [], [])))
 
     def _state(self, name: str, data: dict, rows: list[Row]) -> None:
         t = self._time(data["tick"])
@@ -278,6 +316,19 @@ class RowMaker:
         if detail and detail != kind:
             text += f": {detail}"
         rows.append(Row(event_path(kind), kinds.text, t, (text, LEVELS.get(kind, "INFO"))))
+
+
+def _passages(map_msg: dict, radius: float) -> Row:
+    """The passages of the map (``planner.passages``) as a translucent image over it."""
+    grid = map_grid(map_msg)
+    passages = Passages.build(Costmap.build(grid, Clearance(radius)))
+    inside = passages.label[::-1] != NONE  # image rows top down
+    rgba = np.zeros((*inside.shape, 4), dtype=np.uint8)
+    rgba[inside] = PASSAGE_RGBA
+    x0, _, _, y1 = grid.extent
+    res = grid.resolution
+    place = rr.Transform3D(translation=[x0, y1, 0.0], scale=[res, -res, 1.0])
+    return Row(PASSAGES, None, None, [place, rr.Image(rgba, color_model="RGBA", draw_order=0.5)])
 
 
 def _start(name: str, x: float, y: float, r: float) -> Row:

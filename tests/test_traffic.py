@@ -4,13 +4,17 @@ that take turns in passages one AGV wide (in process; over Zenoh in test_fleet_z
 from __future__ import annotations
 
 from bridge import keys
-from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.scenario import load_scenario, parse_scenario
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.map_io import parse_text_grid
 from planner.passages import NONE, Passages
 from planner.traffic import GO, REQUEST, WAIT, YIELD, Intent, may_enter, waiting_for
+from recordings.analysis import analyze
+from recordings.reader import open_recording
+from recordings.rerun_view import save_rrd
+from tests.test_rerun import read_rrd
 
 ROOM = "#" + "." * 12 + "#" * 14 + "." * 12 + "#"
 CORRIDOR = "#" + "." * 38 + "#"
@@ -156,3 +160,28 @@ def test_single_lane_builtin_four_agvs_swap_rooms_without_contact():
     assert summary.success, summary.table()
     assert any(e.kind == WAIT for e in events)
     assert sum(a.waiting_time for a in summary.agvs) > 0
+
+
+def test_the_recording_and_rerun_show_who_waits_where_and_the_passages(tmp_path):
+    mid = 3.75
+    text = corridor_swap(3, [("a", (2.0, mid), (18.0, mid)), ("b", (18.0, mid), (2.0, mid))])
+    scenario = parse_scenario(text)
+    mcap, rrd = tmp_path / "swap.mcap", tmp_path / "swap.rrd"
+    run_recorded(scenario, mcap, {})
+    recording = open_recording(mcap)
+    analysis = analyze(recording)
+    by_name = {a.name: a for a in analysis.agvs}
+    assert by_name["b"].waiting_time > 5.0 and by_name["b"].waits == 1
+    assert by_name["a"].waiting_time == 0.0 and analysis.traffic_events == 2  # wait, go
+    save_rrd(recording, rrd)
+    shown = read_rrd(rrd)
+    assert shown["/world/passages"].static >= 1
+    ticks = [m.data for m in recording.of("world/tick")]
+    held = [t for t in ticks if any(i["name"] == "b" and i["phase"] == WAIT for i in t["intents"])]
+    rings = [r for r in shown["/world/agv/b/waiting"].rows if r[1]["Points2D:positions"]]
+    assert len(rings) == len(held)
+    assert all(r[1]["Points2D:labels"] == ["waits for a"] for r in rings)
+    assert "/world/agv/a/waiting" not in shown or not any(
+        r[1]["Points2D:positions"] for r in shown["/world/agv/a/waiting"].rows
+    )
+    assert len(shown["/events/wait"].rows) == 1 and len(shown["/events/go"].rows) == 1
