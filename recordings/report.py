@@ -28,12 +28,12 @@ AGV_COLUMNS = (
     ("obstacle", "gap m", "min_clearance_obstacles", "{:.2f}", True),
     ("AGV", "gap m", "min_clearance_agvs", "{:.2f}", True),
     ("collisions", "", "collisions", "{}", True),
-    ("waiting", "s", "waiting_time", "{:.1f}", True),
+    ("waiting", "s", "waiting_time", "{:.1f}", False),
     ("waits", "", "waits", "{}", False),
     ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
     ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
 )
-HIDDEN_NOTE = "(--wide adds turns, turning angle, |Δω|, ω sign changes and planning times)"
+HIDDEN_NOTE = "(--wide adds turns, turning angle, |Δω|, ω sign changes, planning and waiting times)"
 
 
 def _cell(value, fmt: str) -> str:
@@ -60,7 +60,19 @@ def run_table(run: RunAnalysis, wide: bool = False) -> str:
     )
     table = text_table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
     note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
-    return f"{table}\n{line}{note}"
+    return f"{table}\n{line}{_traffic_line(run)}{note}"
+
+
+def _traffic_line(run: RunAnalysis) -> str:
+    """The traffic rule's part in the run, when it had one: who waited how long."""
+    if not run.traffic_events:
+        return ""
+    waited = sorted((a for a in run.agvs if a.waiting_time > 0), key=lambda a: -a.waiting_time)
+    each = ", ".join(f"{a.name} {a.waiting_time:.1f} s" for a in waited[:4])
+    more = f" and {len(waited) - 4} more" if len(waited) > 4 else ""
+    return f"\ntraffic: {run.traffic_events} decisions, {run.waiting_time:.1f} s waiting in all" + (
+        f" ({each}{more})" if each else ""
+    )
 
 
 def comparison_table(runs: list[RunAnalysis]) -> str:
