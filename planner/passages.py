@@ -59,7 +59,7 @@ class Passages:
     mouth: np.ndarray  # (H, W) int32: mouth id (ids unique over the map), or NONE
     count: int
     join_distance: float  # m: passages closer than this through free space are one
-    _centres_of: dict = field(default_factory=dict, repr=False)  # passage -> cell centres
+    _centres_of: dict = field(default_factory=dict, repr=False)  # per passage, computed once
 
     @classmethod
     def for_costmap(cls, costmap: Costmap) -> Passages:
@@ -97,6 +97,27 @@ class Passages:
         if not self.grid.contains_cell((col, row)):
             return NONE
         return int(self.label[row, col])
+
+    def mouths(self, passage: int) -> dict[int, Point]:
+        """The mouths of a passage and the centre of each (mean of its cell centres)."""
+        key = ("mouths", passage)
+        found = self._centres_of.get(key)
+        if found is None:
+            res, (ox, oy) = self.grid.resolution, self.grid.origin
+            found = {}
+            for mouth in np.unique(self.mouth[self.mouth != NONE]):
+                rows, cols = np.nonzero(self.mouth == mouth)
+                if _touches(self.label, int(cols[0]), int(rows[0]), passage):
+                    centre = (ox + (cols.mean() + 0.5) * res, oy + (rows.mean() + 0.5) * res)
+                    found[int(mouth)] = (float(centre[0]), float(centre[1]))
+            self._centres_of[key] = found
+        return found
+
+    def nearest_cell_centre(self, point: Point, passage: int) -> Point:
+        """The centre of the passage's cell nearest to a world point."""
+        centres = self._centres(passage)
+        i = int(np.argmin(np.hypot(centres[:, 0] - point[0], centres[:, 1] - point[1])))
+        return float(centres[i, 0]), float(centres[i, 1])
 
     def distance_to(self, point: Point, passage: int) -> float:
         """Distance (m) from a world point to the nearest cell centre of a passage."""

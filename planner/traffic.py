@@ -16,11 +16,14 @@ The rule, for an AGV whose route enters passage P within its request distance:
    mouth as the head may enter; the queue stops at the first one that does not
    (first come, first served, so nobody waits for ever behind a convoy).
 3. An AGV that may not enter waits (phase ``wait``) at a place outside P, off its route
-   (``planner.traffic_guard``). Holders never wait for a passage while inside one
-   (the first passage on a route is the one it is in), and passages closer than one
-   waiting place are one passage, so waiting AGVs never wait for each other in a
-   cycle; a holder that cannot move (blocked by a body) is the remaining deadlock, and
-   ``stalled`` intents let the waiters see it and give way.
+   (``planner.traffic_guard``). Holders never wait for a passage while inside one (the
+   first passage on a route is the one it is in), and passages closer than one waiting
+   place are one passage, so waiting AGVs never wait for each other in a cycle.
+4. What is left is broken at once. Two AGVs that meet inside P going opposite ways (they
+   started there): the later one (``since``, then name) backs out beyond the mouth
+   behind it (phase ``back``) and queues. A holder that cannot move (blocked by a body)
+   says so in its intent (``stalled``): the AGVs waiting for P move further back
+   (phase ``yield``).
 
 An AGV whose route ends inside P (a goal in a dock) leaves it through no mouth
 (``exit`` None): it goes alone.
@@ -35,8 +38,13 @@ REQUEST = "request"  # asking for a passage, not yet answered (first tick of a r
 WAIT = "wait"  # asked, not allowed yet: waiting outside the passage
 GO = "go"  # allowed in, or inside: holds the passage
 YIELD = "yield"  # waiting, and moved further back: a holder cannot move
-PHASES = (CLEAR, REQUEST, WAIT, GO, YIELD)
-DECISIONS = (WAIT, GO, YIELD)
+BACK = "back"  # met a holder going the other way inside: backs out (a deadlock broken)
+PHASES = (CLEAR, REQUEST, WAIT, GO, YIELD, BACK)
+DECISIONS = (WAIT, GO, YIELD, BACK)
+HELD = (WAIT, YIELD, BACK)
+"""The phases of an AGV the rule holds at a waiting place."""
+QUEUED = (REQUEST, *HELD)
+"""The phases of an AGV that asked for a passage and is not in it."""
 """The phases whose start is a traffic decision: a world event of that kind."""
 
 
@@ -69,7 +77,7 @@ def holders(passage: int, intents: list[Intent]) -> list[Intent]:
 
 def queue(passage: int, intents: list[Intent]) -> list[Intent]:
     """The AGVs asking for ``passage``, first come first."""
-    asking = [i for i in intents if i.passage == passage and i.phase in (REQUEST, WAIT, YIELD)]
+    asking = [i for i in intents if i.passage == passage and i.phase in QUEUED]
     return sorted(asking, key=lambda i: (i.since, i.name))
 
 
@@ -98,11 +106,22 @@ def may_enter(name: str, intents: list[Intent]) -> tuple[bool, list[str]]:
     return False, ahead
 
 
+def first_rival(me: Intent, intents: list[Intent]) -> str | None:
+    """A holder of my passage that goes the other way and came first (earlier ``since``,
+    then name): two AGVs that meet inside a passage (both started there), and the later
+    one backs out. None when I have no such rival."""
+    rivals = [
+        h for h in holders(me.passage, intents)
+        if h.name != me.name and not _same_way(h, me) and (h.since, h.name) < (me.since, me.name)
+    ]  # fmt: skip
+    return min(rivals, key=lambda h: (h.since, h.name)).name if rivals else None
+
+
 def waiting_for(intents: list[Intent]) -> dict[str, list[str]]:
     """The wait-for graph: every waiting AGV and the AGVs it waits for."""
     graph = {}
     for intent in intents:
-        if intent.phase in (WAIT, YIELD):
+        if intent.phase in HELD:
             allowed, blockers = may_enter(intent.name, intents)
             if not allowed:
                 graph[intent.name] = blockers

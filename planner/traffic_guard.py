@@ -21,7 +21,19 @@ from planner.costmap import Costmap
 from planner.dwa import DwaConfig
 from planner.grid_map import Point
 from planner.passages import NONE, Crossing, Passages
-from planner.traffic import CLEAR, GO, REQUEST, WAIT, YIELD, Intent, may_enter, stuck_holders
+from planner.traffic import (
+    BACK,
+    CLEAR,
+    GO,
+    HELD,
+    REQUEST,
+    WAIT,
+    YIELD,
+    Intent,
+    first_rival,
+    may_enter,
+    stuck_holders,
+)  # fmt: skip
 
 WAIT_BACK = (3.0, 4.0, 6.0)
 """The waiting place is this many safety distances before the passage along the route
@@ -88,22 +100,28 @@ class TrafficGuard:
             round(crossing.enter_at, 2), stalled, shared,
         )  # fmt: skip
         if crossing.enter_at <= 0.0 or self._phase == GO:
-            intent.phase = self._phase = GO  # inside, or allowed in: holds the passage
-            return self._decision(intent)
+            rival = first_rival(intent, intents)
+            if rival is None:
+                intent.phase = self._phase = GO  # inside, or allowed in: holds the passage
+                return self._decision(intent)
+            if self._phase != BACK:  # nose to nose inside: the later one backs out
+                self._hold = self._outside(position, crossing)
+            intent.phase = self._phase = BACK
+            return self._decision(intent, self._hold, [rival])
         seen = next((i for i in intents if i.name == name), None)
         if seen is None or (seen.passage, seen.exit, seen.since) != (*claim, self._since):
             return self._decision(intent)  # the fleet has not seen this claim yet
         allowed, blockers = may_enter(name, intents)
         if allowed:
-            waited = self._phase in (WAIT, YIELD)
+            waited = self._phase in HELD
             intent.phase = self._phase = GO
             return self._decision(intent, rejoin=waited)
         if self._hold is None:
             self._hold = self._waiting_place(route, along + crossing.enter_at)
-        if stuck_holders(crossing.passage, intents) and self._phase != YIELD:
+        if stuck_holders(crossing.passage, intents) and self._phase not in (YIELD, BACK):
             self._hold = self._further_back(route, along + crossing.enter_at)
             intent.phase = self._phase = YIELD
-        elif self._phase != YIELD:
+        elif self._phase not in (YIELD, BACK):
             intent.phase = self._phase = WAIT
         return self._decision(intent, self._hold, blockers)
 
@@ -117,7 +135,7 @@ class TrafficGuard:
         return self.passages.distance_to(position, self._claim[0]) < self.release_distance
 
     def _decision(self, intent: Intent, hold=None, blockers=(), rejoin=False) -> TrafficDecision:
-        if intent.phase not in (WAIT, YIELD):
+        if intent.phase not in HELD:
             self._hold = None
         intent.waits_for = sorted(blockers)
         return TrafficDecision(intent, hold, rejoin)
@@ -134,6 +152,27 @@ class TrafficGuard:
                 if self._room_at(place) and self._room_at(_midpoint(point, place)):
                     return place
         return _point_along(route, max(0.0, enter_at - WAIT_BACK[0] * safety))[0]
+
+    def _outside(self, position: Point, crossing: Crossing) -> Point:
+        """A waiting place beyond the passage's nearest mouth that is not the exit: where
+        an AGV inside backs out to."""
+        mouths = {m: c for m, c in self.passages.mouths(crossing.passage).items()}
+        mouths.pop(crossing.exit, None)
+        if not mouths:
+            return position
+        mouth = min(mouths.values(), key=lambda c: math.dist(c, position))
+        inner = self.passages.nearest_cell_centre(mouth, crossing.passage)
+        away = (mouth[0] - inner[0], mouth[1] - inner[1])
+        norm = math.hypot(*away) or 1.0
+        safety = self.costmap.clearance.safety_distance
+        for back in WAIT_BACK:
+            place = (
+                mouth[0] + away[0] / norm * back * safety,
+                mouth[1] + away[1] / norm * back * safety,
+            )
+            if self._room_at(place):
+                return place
+        return mouth
 
     def _further_back(self, route: list[Point], enter_at: float) -> Point:
         """A waiting place twice as far from the passage, where there is room (a holder

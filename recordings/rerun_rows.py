@@ -47,7 +47,7 @@ from planner.agv_status import FINISHED
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.passages import NONE, Passages
-from planner.traffic import WAIT, YIELD
+from planner.traffic import HELD
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
 from recordings.palette import agv_color
@@ -263,7 +263,7 @@ class RowMaker:
         held = {
             i["name"]: i.get("waits_for", [])
             for i in data.get("intents", [])  # none in recordings before the traffic rule
-            if i["phase"] in (WAIT, YIELD)
+            if i["phase"] in HELD
         }
         for s in data["agvs"]:
             name = s["name"]

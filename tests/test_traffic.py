@@ -10,7 +10,17 @@ from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.map_io import parse_text_grid
 from planner.passages import NONE, Passages
-from planner.traffic import GO, REQUEST, WAIT, YIELD, Intent, may_enter, waiting_for
+from planner.traffic import (
+    BACK,
+    GO,
+    REQUEST,
+    WAIT,
+    YIELD,
+    Intent,
+    first_rival,
+    may_enter,
+    waiting_for,
+)  # fmt: skip
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 from recordings.rerun_view import save_rrd
@@ -185,3 +195,23 @@ def test_the_recording_and_rerun_show_who_waits_where_and_the_passages(tmp_path)
         r[1]["Points2D:positions"] for r in shown["/world/agv/a/waiting"].rows
     )
     assert len(shown["/events/wait"].rows) == 1 and len(shown["/events/go"].rows) == 1
+
+
+def test_two_agvs_that_meet_inside_a_corridor_the_later_backs_out_and_both_arrive():
+    """Both start inside, nose to nose: a deadlock the rule breaks at once (``back``)."""
+    mid = 3.75
+    text = corridor_swap(3, [("a", (8.5, mid), (18.0, mid)), ("b", (11.5, mid), (2.0, mid))])
+    summary, events = run_with_events(parse_scenario(text))
+    assert summary.success, summary.table()
+    backs = [e for e in events if e.kind == BACK]
+    assert [e.agvs for e in backs] == [["b", "a"]]  # same first ask: by name, b is later
+    by_name = {a.name: a for a in summary.agvs}
+    assert by_name["a"].arrival_time < by_name["b"].arrival_time
+
+
+def test_first_rival_is_the_earlier_holder_going_the_other_way():
+    me = claim("m", GO, 1, 4)
+    assert first_rival(me, [me, claim("x", GO, 2, 3), claim("y", GO, 2, 2)]) == "y"
+    assert first_rival(me, [me, claim("x", GO, 2, 5)]) is None  # I came first: x backs out
+    assert first_rival(me, [me, claim("x", GO, 1, 1)]) is None  # same way: a convoy
+    assert first_rival(me, [me, claim("x", WAIT, 2, 1)]) is None  # not inside
