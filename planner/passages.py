@@ -86,6 +86,7 @@ class Passages:
         narrow = free & (to_two_lane > lane)
         join = WAIT_ROOM * clearance.safety_distance
         label = _label_passages(narrow, free, max(1, math.ceil(join / res)))
+        label = _without_nooks(label, _label_mouths(label, free), clearance.safety_distance / res)
         mouth = _label_mouths(label, free)
         for array in (label, mouth):
             array.setflags(write=False)
@@ -200,6 +201,34 @@ def _samples(route: list[Point], step: float) -> tuple[np.ndarray, np.ndarray]:
     starts = np.concatenate(([0.0], np.cumsum(lengths)))
     along = np.concatenate((starts[segment] + lengths[segment] * t, starts[-1:]))
     return points, along
+
+
+def _without_nooks(label: np.ndarray, mouth: np.ndarray, depth: float) -> np.ndarray:
+    """``label`` without the nooks: a passage with one mouth whose every cell is within
+    ``depth`` cells of it (a room's corner, where no two-lane cell is near, is no
+    passage; a dock deeper than that is). Ids renumbered in row-major order."""
+    rows, cols = np.nonzero(label != NONE)
+    if not len(rows):
+        return label
+    ids = label[rows, cols]
+    order = np.argsort(ids, kind="stable")
+    starts = np.flatnonzero(np.diff(ids[order], prepend=-2))
+    keep = label.copy()
+    for members in np.split(order, starts[1:]):
+        r, c = rows[members], cols[members]
+        box = (slice(max(r.min() - 1, 0), r.max() + 2), slice(max(c.min() - 1, 0), c.max() + 2))
+        mouth_rows, mouth_cols = np.nonzero(mouth[box] != NONE)
+        if len(np.unique(mouth[box][mouth_rows, mouth_cols])) != 1:
+            continue
+        mouth_rows, mouth_cols = mouth_rows + box[0].start, mouth_cols + box[1].start
+        gaps = np.hypot(r[:, None] - mouth_rows, c[:, None] - mouth_cols).min(axis=1)
+        if gaps.max() <= depth:
+            keep[r, c] = NONE
+    present = keep[keep != NONE]  # row-major
+    values, first = np.unique(present, return_index=True)
+    renumber = np.full(int(label.max()) + 2, NONE, dtype=np.int32)
+    renumber[values[np.argsort(first)]] = np.arange(len(values), dtype=np.int32)
+    return np.where(keep == NONE, NONE, renumber[keep]).astype(np.int32)
 
 
 def _touches(label: np.ndarray, col: int, row: int, passage: int) -> bool:

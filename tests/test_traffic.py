@@ -61,19 +61,20 @@ def test_a_corridor_one_agv_wide_is_one_passage_with_a_mouth_at_each_end():
 
 def test_wide_corridors_and_open_maps_have_no_passages():
     assert passages_of(two_rooms(4)).count == 0  # 2 m: two AGVs pass
+    room = ["#" * 18, *["#" + "." * 16 + "#"] * 16, "#" * 18]  # 4 x 4 m at 0.25 m
+    assert passages_of("\n".join(room), resolution=0.25).count == 0  # corners are nooks
     for name in ("corridor", "crossing", "warehouse"):  # 2 and 3 m lanes at 1 m cells
         grid = load_scenario(name).grid
         assert Passages.build(Costmap.build(grid, Clearance())).count == 0, name
 
 
 def test_a_dock_is_a_passage_with_one_mouth_and_a_route_ending_inside_has_no_exit():
-    rows = ["#" * 20, *["#" + "." * 18 + "#"] * 8, "#" * 9 + "..." + "#" * 8, "#" * 20]
-    rows.insert(10, "#" * 9 + "..." + "#" * 8)
-    rows.insert(10, "#" * 9 + "..." + "#" * 8)
+    dock = "#" * 9 + "..." + "#" * 8  # 1.5 m wide, 3 m deep, below a 9 x 4 m room
+    rows = ["#" * 20, *["#" + "." * 18 + "#"] * 8, *[dock] * 6, "#" * 20]
     passages = passages_of("\n".join(rows))
     assert passages.count == 1
     assert len(set(passages.mouth[passages.mouth != NONE].tolist())) == 1
-    into = passages.first_crossing([(5.0, 3.0), (5.25, 3.0), (5.25, 0.8)], lookahead=30.0)
+    into = passages.first_crossing([(5.0, 6.0), (5.25, 3.5), (5.25, 0.8)], lookahead=30.0)
     assert into is not None and into.exit is None
 
 
