@@ -353,12 +353,25 @@ def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
     (capped at ``cap``): trajectories that stay on the global route score highest, so
     the AGV lines up with a narrow passage the route goes through before it gets there."""
     (ax, ay), (bx, by) = segment
-    dx, dy = bx - ax, by - ay
+    offsets = _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
+    return cap - np.minimum(offsets, cap)
+
+
+@numba.njit(cache=True)
+def _largest_offsets(xs, ys, ax, ay, dx, dy):
+    """(N,) the largest distance of each trajectory (N, K) from the segment from (ax, ay)
+    along (dx, dy); one pass instead of eight (N, K) numpy temporaries."""
     length2 = dx * dx + dy * dy
-    t = np.zeros_like(xs) if length2 < _EPS else ((xs - ax) * dx + (ys - ay) * dy) / length2
-    t = np.clip(t, 0.0, 1.0)
-    off = np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
-    return cap - np.minimum(off, cap)
+    n_traj, n_steps = xs.shape
+    out = np.empty(n_traj)
+    for n in range(n_traj):
+        largest = 0.0
+        for k in range(n_steps):
+            t = 0.0 if length2 < _EPS else ((xs[n, k] - ax) * dx + (ys[n, k] - ay) * dy) / length2
+            t = min(max(t, 0.0), 1.0)
+            largest = max(largest, math.hypot(xs[n, k] - (ax + t * dx), ys[n, k] - (ay + t * dy)))
+        out[n] = largest
+    return out
 
 
 def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarray:

@@ -54,7 +54,8 @@ class AgvNode:
     def warm_up(self) -> None:
         """Load (or compile) every numba kernel this node uses, before the run starts."""
         warm_up()
-        self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
+        start, goal = self.spec.start, self.spec.goal
+        self.controller.dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, segment=(start, goal))
         walker = np.array([[*self.spec.start, 0.0, 0.0, 0.1]])  # the evasion kernel, too
         self.controller.dwa.threatened((*self.spec.start, 0.0), walker)
 
