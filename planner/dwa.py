@@ -360,16 +360,26 @@ def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
 @numba.njit(cache=True)
 def _largest_offsets(xs, ys, ax, ay, dx, dy):
     """(N,) the largest distance of each trajectory (N, K) from the segment from (ax, ay)
-    along (dx, dy); one pass instead of eight (N, K) numpy temporaries."""
+    along (dx, dy), as ``np.hypot(...).max(axis=1)`` gives it, bit for bit. ``math.hypot``
+    is slow compiled, so it is taken only for the steps whose squared distance is within
+    rounding of the largest (those alone can hold the largest hypot)."""
     length2 = dx * dx + dy * dy
     n_traj, n_steps = xs.shape
     out = np.empty(n_traj)
+    ex = np.empty(n_steps)
+    ey = np.empty(n_steps)
     for n in range(n_traj):
-        largest = 0.0
+        largest2 = 0.0
         for k in range(n_steps):
             t = 0.0 if length2 < _EPS else ((xs[n, k] - ax) * dx + (ys[n, k] - ay) * dy) / length2
             t = min(max(t, 0.0), 1.0)
-            largest = max(largest, math.hypot(xs[n, k] - (ax + t * dx), ys[n, k] - (ay + t * dy)))
+            ex[k] = xs[n, k] - (ax + t * dx)
+            ey[k] = ys[n, k] - (ay + t * dy)
+            largest2 = max(largest2, ex[k] * ex[k] + ey[k] * ey[k])
+        largest = 0.0
+        for k in range(n_steps):
+            if ex[k] * ex[k] + ey[k] * ey[k] >= largest2 * (1.0 - 1e-9):
+                largest = max(largest, math.hypot(ex[k], ey[k]))
         out[n] = largest
     return out
 

@@ -15,6 +15,7 @@ from planner.dwa import (
     braking_command,
     dynamic_window,
     lower_by_discs,
+    on_route,
     rollout,
     static_clearance,
     step_pose,
@@ -151,6 +152,18 @@ def test_discs_lower_the_clearance_exactly_as_the_minimum_over_steps_and_discs()
     assert (want > 0).any() and (want <= 0).any()
     assert np.array_equal(got[want > 0], want[want > 0])
     assert (got[want <= 0] <= 0).all()
+
+
+def test_on_route_scores_the_largest_distance_from_the_route_segment():
+    # two trajectories along y = 1 and y = 0.5 beside the segment (0, 0)-(4, 0), the first
+    # running past its end to (6, 1): its largest distance is to the end point, sqrt(5)
+    xs = np.array([np.linspace(0.5, 6.0, 12), np.linspace(0.5, 3.0, 12)])
+    ys = np.array([np.full(12, 1.0), np.full(12, 0.5)])
+    got = on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 3.0)
+    assert got == pytest.approx([3.0 - math.sqrt(5.0), 2.5], abs=1e-12)
+    assert on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 1.0) == pytest.approx([0.0, 0.5])
+    # a segment of no length: the distance to its point
+    assert on_route(xs[1:, :1], ys[1:, :1], ((0.5, 0.0), (0.5, 0.0)), 3.0)[0] == 2.5
 
 
 def test_static_clearance_subtracts_the_radius():
