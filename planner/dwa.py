@@ -208,13 +208,25 @@ def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarr
     omegas, which = np.unique(commands[:, 2], return_inverse=True)
     headings = theta0 + omegas[:, None] * (np.arange(steps + 1) * dt)  # (W, K+1), steps 0..K
     # the displacement of step k uses the heading at its start (step k-1)
-    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)[which] * dt
-    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)[which] * dt
-    vx, vy = commands[:, 0:1], commands[:, 1:2]
-    out = np.empty((3, len(commands), steps))
-    out[0] = x0 + vx * cos_sum - vy * sin_sum
-    out[1] = y0 + vx * sin_sum + vy * cos_sum
-    out[2] = headings[which, 1:]
+    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)
+    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)
+    return _positions(float(x0), float(y0), commands, which, headings, cos_sum, sin_sum, dt)
+
+
+@numba.njit(cache=True)
+def _positions(x0, y0, commands, which, headings, cos_sum, sin_sum, dt):
+    """``rollout``'s (3, N, K) from the sums of each distinct omega's headings, in one
+    pass (as numpy computed it elementwise, so bit for bit the same, without six (N, K)
+    temporaries)."""
+    n_commands, steps = commands.shape[0], cos_sum.shape[1]
+    out = np.empty((3, n_commands, steps))
+    for i in range(n_commands):
+        w, vx, vy = which[i], commands[i, 0], commands[i, 1]
+        for k in range(steps):
+            c, s = cos_sum[w, k] * dt, sin_sum[w, k] * dt
+            out[0, i, k] = x0 + vx * c - vy * s
+            out[1, i, k] = y0 + vx * s + vy * c
+            out[2, i, k] = headings[w, k + 1]
     return out
 
 
