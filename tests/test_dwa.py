@@ -14,8 +14,10 @@ from planner.dwa import (
     admissible_mask,
     braking_command,
     dynamic_window,
-    min_clearance,
+    lower_by_discs,
+    on_route,
     rollout,
+    static_clearance,
     step_pose,
 )
 from planner.grid_map import GridMap
@@ -125,14 +127,49 @@ def test_moving_discs_are_predicted_at_the_time_of_each_step():
     cfg = DwaConfig(predict_time=1.0)
     xs, ys, _ = rollout((5.0, 5.0, 0.0), np.zeros((1, 3)), cfg.dt, cfg.steps)  # standing still
     disc = np.array([[3.0, 6.0, 1.0, 0.0, 0.2]])  # at (4, 6) after the horizon's last step (1 s)
-    clearance = min_clearance(xs, ys, field.samples, 1 / field.spacing, disc, cfg.dt, cfg.radius)
+    static = static_clearance(xs, ys, field.samples, 1 / field.spacing, cfg.radius)
+    clearance = lower_by_discs(xs, ys, static, disc, cfg.dt, cfg.radius)
     assert clearance[0] == pytest.approx(math.sqrt(2) - 0.2 - cfg.radius, abs=1e-9)
+
+
+def test_discs_lower_the_clearance_exactly_as_the_minimum_over_steps_and_discs():
+    # the kernel skips the square root of pairs too far to matter: the result must still be
+    # the exact minimum wherever it is positive (and not positive where that is not)
+    field = open_field(10, 10)
+    rng = np.random.default_rng(3)
+    commands = np.column_stack((rng.uniform(0, 1, 200), rng.uniform(-1, 1, 200), np.zeros(200)))
+    xs, ys, _ = rollout((5.0, 5.0, 0.0), commands, CFG.dt, CFG.steps)
+    discs = np.column_stack(
+        (rng.uniform(1, 9, (8, 2)), rng.uniform(-0.5, 0.5, (8, 2)), rng.uniform(0.1, 0.3, 8))
+    )
+    static = static_clearance(xs, ys, field.samples, 1 / field.spacing, CFG.radius)
+    got = lower_by_discs(xs, ys, static, discs, CFG.dt, CFG.radius)
+    t = (np.arange(CFG.steps) + 1) * CFG.dt
+    dx = xs[:, :, None] - (discs[:, 0] + discs[:, 2] * t[:, None])
+    dy = ys[:, :, None] - (discs[:, 1] + discs[:, 3] * t[:, None])
+    gaps = np.sqrt(dx * dx + dy * dy) - discs[:, 4] - CFG.radius
+    want = np.minimum(static, gaps.min(axis=(1, 2)))
+    assert (want > 0).any() and (want <= 0).any()
+    assert np.array_equal(got[want > 0], want[want > 0])
+    assert (got[want <= 0] <= 0).all()
+
+
+def test_on_route_scores_the_largest_distance_from_the_route_segment():
+    # two trajectories along y = 1 and y = 0.5 beside the segment (0, 0)-(4, 0), the first
+    # running past its end to (6, 1): its largest distance is to the end point, sqrt(5)
+    xs = np.array([np.linspace(0.5, 6.0, 12), np.linspace(0.5, 3.0, 12)])
+    ys = np.array([np.full(12, 1.0), np.full(12, 0.5)])
+    got = on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 3.0)
+    assert got == pytest.approx([3.0 - math.sqrt(5.0), 2.5], abs=1e-12)
+    assert on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 1.0) == pytest.approx([0.0, 0.5])
+    # a segment of no length: the distance to its point
+    assert on_route(xs[1:, :1], ys[1:, :1], ((0.5, 0.0), (0.5, 0.0)), 3.0)[0] == 2.5
 
 
 def test_static_clearance_subtracts_the_radius():
     field = open_field(10, 10)
     xs, ys, _ = rollout((1.5, 5.0, 0.0), np.array([[0.0, 0.0, 0.0]]), 0.1, 5)
-    clearance = min_clearance(xs, ys, field.samples, 1 / field.spacing, np.zeros((0, 5)), 0.1, 0.3)
+    clearance = static_clearance(xs, ys, field.samples, 1 / field.spacing, 0.3)
     assert clearance[0] == pytest.approx(1.2, abs=0.05)
 
 

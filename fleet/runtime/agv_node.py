@@ -57,9 +57,11 @@ class AgvNode:
     def warm_up(self) -> None:
         """Load (or compile) every numba kernel this node uses, before the run starts."""
         warm_up()
-        self.controller.dwa.plan((*self.spec.start, 0.0), (0.0, 0.0, 0.0), self.spec.goal)
-        walker = np.array([[*self.spec.start, 0.0, 0.0, 0.1]])  # the evasion kernel, too
-        self.controller.dwa.threatened((*self.spec.start, 0.0), walker)
+        start, goal, dwa = self.spec.start, self.spec.goal, self.controller.dwa
+        dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, segment=(start, goal))
+        walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
+        dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, walker)
+        dwa.threatened((*start, 0.0), walker)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""

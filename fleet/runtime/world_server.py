@@ -159,14 +159,24 @@ class WorldServer:
             if someone_lost and (self._rejoined or now - sent > RESEND_S):
                 self.bus.publish(keys.WORLD_TICK, tick)
                 sent, self._rejoined = now, False
-            try:
-                received = self._commands.get(timeout=POLL_S)
-            except queue.Empty:
-                continue
-            command = received.msg
-            if command.tick == wanted and received.key == keys.agv_command(command.name):
-                replies[command.name] = command
-                self._lost.pop(command.name, None)
+            for received in self._arrived_commands():
+                command = received.msg
+                if command.tick == wanted and received.key == keys.agv_command(command.name):
+                    replies[command.name] = command
+                    self._lost.pop(command.name, None)
+
+    def _arrived_commands(self) -> list:
+        """The commands waiting (at least one, if one comes within POLL_S): taken together,
+        so that the check of who is still awaited runs once per batch, not once per AGV
+        (with 100 AGVs, 10,000 checks a tick)."""
+        try:
+            arrived = [self._commands.get(timeout=POLL_S)]
+        except queue.Empty:
+            return []
+        with contextlib.suppress(queue.Empty):
+            while True:
+                arrived.append(self._commands.get_nowait())
+        return arrived
 
     def _why_failed(self, name: str) -> str:
         if name not in self.alive:
