@@ -516,8 +516,9 @@ class DwaPlanner:
         if ok.size == 0:
             if self.behaviour.evade:
                 times = contact_times(
-                    xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
-                )
+                    xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius,
+                    *field.origin,
+                )  # fmt: skip
                 best = evasive_index(*times)
                 chosen = tuple(float(v) for v in commands[best])
                 path = (xs[best], ys[best], thetas[best])
@@ -566,7 +567,7 @@ class DwaPlanner:
         xs, ys, _ = rollout(pose, np.zeros((1, 3)), cfg.dt, cfg.steps)
         discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
         _, moving_first, _ = contact_times(
-            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius
+            xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
         )
         return bool(np.isfinite(moving_first[0]))
 

@@ -21,11 +21,12 @@ from planner.distance_field import lookup
 
 
 @numba.njit(cache=True)
-def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius):
+def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0.0):
     """(N,) times of each trajectory's first contact with the static map and with a moving
     disc (inf: none), (N,) its lowest clearance.
 
-    ``xs``, ``ys`` (N, K) as in ``dwa.static_clearance``; moving discs (M, 5) rows
+    ``xs``, ``ys`` (N, K) as in ``dwa.static_clearance``, on a distance field whose map
+    origin is (``ox``, ``oy``); moving discs (M, 5) rows
     [x, y, vx, vy, r] at constant velocity. Unlike ``dwa.lower_by_discs`` the whole
     horizon is evaluated, so the lowest clearance ranks trajectories in contact.
     """
@@ -37,7 +38,7 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius):
         worst = np.inf
         for k in range(n_steps):
             x, y, t = xs[n, k], ys[n, k], (k + 1) * dt
-            c = lookup(samples, inv_spacing, x, y) - radius
+            c = lookup(samples, inv_spacing, x - ox, y - oy) - radius
             if c <= 0.0 and static_first[n] == np.inf:
                 static_first[n] = t
             for m in range(moving.shape[0]):

@@ -26,6 +26,7 @@ from fleet.scenario import (
 )
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
+from planner.evasion import contact_times
 from planner.fusion import FusionConfig
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
@@ -79,6 +80,23 @@ def test_evasive_fallback_steps_out_of_a_walkers_way_where_the_paper_brakes():
     assert not evade.admissible and evade.command != still
     # the walker's predicted path is x = 6: the evasive step moves away from it
     assert abs(evade.trajectory[-1, 0] - 6.0) > 0.05
+
+
+def test_the_evasive_fallback_reads_the_map_where_it_is_in_a_shifted_map_frame():
+    """A ROS map's origin moves the map, not where the fallback sees its walls."""
+    rows = ["." * 12] * 5 + ["#" * 12] + ["." * 12] * 6  # a wall across y = 6..7
+    for origin in ((0.0, 0.0), (100.0, -50.0)):
+        grid = GridMap.from_rows_top_down(
+            parse_text_grid("\n".join(rows)).blocked[::-1], 1.0, "m", origin
+        )
+        field = DistanceField.from_grid(grid)
+        x = origin[0] + 6.0
+        ys = origin[1] + np.linspace(3.0, 9.0, 30)[None, :]  # straight through the wall
+        static_first, _, lowest = contact_times(
+            np.full_like(ys, x), ys, field.samples, 1.0 / field.spacing,
+            np.zeros((0, 5)), 0.1, 0.3, *field.origin,
+        )  # fmt: skip
+        assert np.isfinite(static_first[0]) and lowest[0] < 0, origin
 
 
 WALLED = "." + "#" * 3 + "." + "#" * 14 + "."  # a wall with a gap at x = 4
