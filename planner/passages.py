@@ -31,23 +31,27 @@ from planner.costmap import Costmap, centre_distances
 from planner.distance_field import _squared_edt
 from planner.grid_map import GridMap, Point
 
-WAIT_ROOM = 2.0
-"""Passages closer than this many safety distances (through free space) are one."""
+WAIT_ROOM = 4.0
+"""Passages closer than about this many safety distances (through free space, counted in
+8-connected cell steps) are one."""
 
 NONE = -1
 """Label of a cell outside every passage / mouth."""
+_NEIGHBOURHOOD = ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1))
 
 
 @dataclass(frozen=True)
 class Crossing:
     """Where a route goes through a passage: entered ``enter_at`` m along the route
-    (0: the route starts inside), left ``leave_at`` m along it through mouth ``exit``
-    (None: the route ends inside, at a goal in a dock or a corridor)."""
+    through mouth ``entry`` (None: the route starts inside), left ``leave_at`` m along it
+    through mouth ``exit`` (None: the route ends inside, at a goal in a dock or a
+    corridor)."""
 
     passage: int
     enter_at: float
     leave_at: float
     exit: int | None
+    entry: int | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -85,8 +89,9 @@ class Passages:
             to_two_lane = np.full(two_lane.shape, np.inf)
         narrow = free & (to_two_lane > lane)
         join = WAIT_ROOM * clearance.safety_distance
-        label = _label_passages(narrow, free, max(1, math.ceil(join / res)))
-        label = _without_nooks(label, _label_mouths(label, free), clearance.safety_distance / res)
+        alone = _label_passages(narrow, free, 0)
+        alone = _without_nooks(alone, _label_mouths(alone, free), clearance.safety_distance / res)
+        label = _label_passages(alone != NONE, free, max(1, math.ceil(join / (2 * res))))
         mouth = _label_mouths(label, free)
         for array in (label, mouth):
             array.setflags(write=False)
@@ -100,19 +105,41 @@ class Passages:
         return int(self.label[row, col])
 
     def mouths(self, passage: int) -> dict[int, Point]:
-        """The mouths of a passage and the centre of each (mean of its cell centres)."""
-        key = ("mouths", passage)
-        found = self._centres_of.get(key)
-        if found is None:
-            res, (ox, oy) = self.grid.resolution, self.grid.origin
-            found = {}
-            for mouth in np.unique(self.mouth[self.mouth != NONE]):
-                rows, cols = np.nonzero(self.mouth == mouth)
-                if _touches(self.label, int(cols[0]), int(rows[0]), passage):
-                    centre = (ox + (cols.mean() + 0.5) * res, oy + (rows.mean() + 0.5) * res)
-                    found[int(mouth)] = (float(centre[0]), float(centre[1]))
-            self._centres_of[key] = found
-        return found
+        """The mouths of a passage and, for each, its cell nearest to its centroid (a
+        mouth that bends round a corner has its centroid in the wall)."""
+        every = self._centres_of.get("mouths")
+        if every is None:
+            every = self._centres_of["mouths"] = self._all_mouths()
+        return every.get(passage, {})
+
+    def _all_mouths(self) -> dict[int, dict[int, Point]]:
+        rows, cols = np.nonzero(self.mouth != NONE)
+        ids = self.mouth[rows, cols]
+        res, (ox, oy) = self.grid.resolution, self.grid.origin
+        xs, ys = ox + (cols + 0.5) * res, oy + (rows + 0.5) * res
+        count = np.bincount(ids)
+        mx, my = (
+            np.bincount(ids, xs) / np.maximum(count, 1),
+            np.bincount(ids, ys) / np.maximum(count, 1),
+        )
+        nearest = {}
+        for i in np.argsort(np.hypot(xs - mx[ids], ys - my[ids]), kind="stable"):
+            nearest.setdefault(
+                int(ids[i]), (float(xs[i]), float(ys[i]), int(rows[i]), int(cols[i]))
+            )
+        out: dict[int, dict[int, Point]] = {}
+        for mouth, (x, y, row, col) in sorted(nearest.items()):
+            passage = self._touching(col, row)
+            out.setdefault(passage, {})[mouth] = (x, y)
+        return out
+
+    def _touching(self, col: int, row: int) -> int:
+        """The passage a mouth cell touches."""
+        for dc, dr in _NEIGHBOURHOOD[1:]:
+            c, r = col + dc, row + dr
+            if self.grid.contains_cell((c, r)) and self.label[r, c] != NONE:
+                return int(self.label[r, c])
+        return NONE
 
     def nearest_cell_centre(self, point: Point, passage: int) -> Point:
         """The centre of the passage's cell nearest to a world point."""
@@ -161,10 +188,12 @@ class Passages:
         mine = np.flatnonzero(labels == passage)
         gaps = np.flatnonzero(np.diff(along[mine]) > self.join_distance)
         last = int(mine[gaps[0]] if len(gaps) else mine[-1])
-        exit = None
+        exit = entry = None
         if last + 1 < len(points) and inside[last + 1]:
             exit = self._mouth_near(int(cols[last + 1]), int(rows[last + 1]), passage)
-        return Crossing(passage, float(along[first]), float(along[last]), exit)
+        if first > 0 and inside[first - 1]:
+            entry = self._mouth_near(int(cols[first - 1]), int(rows[first - 1]), passage)
+        return Crossing(passage, float(along[first]), float(along[last]), exit, entry)
 
     def _mouth_near(self, col: int, row: int, passage: int) -> int | None:
         """The mouth of ``passage`` at or next to a cell (routes sample in half cells)."""
@@ -221,6 +250,8 @@ def _without_nooks(label: np.ndarray, mouth: np.ndarray, depth: float) -> np.nda
         if len(np.unique(mouth[box][mouth_rows, mouth_cols])) != 1:
             continue
         mouth_rows, mouth_cols = mouth_rows + box[0].start, mouth_cols + box[1].start
+        step = max(1, len(mouth_rows) // 64)  # a sample of the mouth bounds the memory
+        mouth_rows, mouth_cols = mouth_rows[::step], mouth_cols[::step]
         gaps = np.hypot(r[:, None] - mouth_rows, c[:, None] - mouth_cols).min(axis=1)
         if gaps.max() <= depth:
             keep[r, c] = NONE
@@ -252,7 +283,8 @@ def _find(parent, i):
 @numba.njit(cache=True)
 def _label_passages(narrow, free, room):
     """Passage ids: 8-connected narrow cells, joined when their components come within
-    ``room`` steps of each other through free cells; ids numbered in row-major order."""
+    ``room`` steps of each other through free cells (each grows ``room`` steps, so
+    components up to 2 ``room`` steps apart join); ids numbered in row-major order."""
     height, width = narrow.shape
     component = np.full((height, width), -1, dtype=np.int32)
     count = 0

@@ -10,15 +10,16 @@ makes the decisions identical in process and over Zenoh.
 The rule, for an AGV whose route enters passage P within its request distance:
 
 1. P is *held* by the AGVs inside it (phase ``go``). An AGV may join the holders only
-   if it leaves P through the same mouth as all of them: a convoy in one direction.
+   if it comes in and leaves by the same mouths as all of them: a convoy.
 2. Otherwise the requesters of P queue by the tick they first asked (``since``), then
    by name. From the head of the queue, every requester that leaves through the same
    mouth as the head may enter; the queue stops at the first one that does not
    (first come, first served, so nobody waits for ever behind a convoy).
 3. An AGV that may not enter waits (phase ``wait``) at a place outside P, off its route
-   (``planner.traffic_guard``). Holders never wait for a passage while inside one (the
-   first passage on a route is the one it is in), and passages closer than one waiting
-   place are one passage, so waiting AGVs never wait for each other in a cycle.
+   (``planner.traffic_guard``), for the holders or for an earlier AGV of the queue. The
+   queue is a total order and holders wait for nobody while they hold (the next
+   passage is claimed when the body is clear of this one), so the wait-for graph has no
+   cycle.
 4. What is left is broken at once. Two AGVs that meet inside P going opposite ways (they
    started there): the later one (``since``, then name) backs out beyond the mouth
    behind it (phase ``back``) and queues. A holder that cannot move (blocked by a body)
@@ -41,11 +42,11 @@ YIELD = "yield"  # waiting, and moved further back: a holder cannot move
 BACK = "back"  # met a holder going the other way inside: backs out (a deadlock broken)
 PHASES = (CLEAR, REQUEST, WAIT, GO, YIELD, BACK)
 DECISIONS = (WAIT, GO, YIELD, BACK)
+"""The phases whose start is a traffic decision: a world event of that kind."""
 HELD = (WAIT, YIELD, BACK)
 """The phases of an AGV the rule holds at a waiting place."""
 QUEUED = (REQUEST, *HELD)
 """The phases of an AGV that asked for a passage and is not in it."""
-"""The phases whose start is a traffic decision: a world event of that kind."""
 
 
 @dataclass
@@ -53,7 +54,8 @@ class Intent:
     """What one AGV tells the fleet each tick: its route ahead and its passage claim.
 
     ``since`` is the tick it first asked for ``passage``; ``enter_at`` the route
-    distance to it (0 inside); ``exit`` the mouth it leaves by (None: it stops inside);
+    distance to it (0 inside); ``entry`` the mouth it comes in by (None: it was inside
+    when it asked); ``exit`` the mouth it leaves by (None: it stops inside);
     ``stalled`` is true when it has made no progress for its progress window;
     ``waits_for`` names the AGVs it waits for (phase ``wait``).
     """
@@ -68,6 +70,7 @@ class Intent:
     stalled: bool = False
     route: list[list[float]] = field(default_factory=list)
     waits_for: list[str] = field(default_factory=list)
+    entry: int | None = None
 
 
 def holders(passage: int, intents: list[Intent]) -> list[Intent]:
@@ -82,7 +85,10 @@ def queue(passage: int, intents: list[Intent]) -> list[Intent]:
 
 
 def _same_way(a: Intent, b: Intent) -> bool:
-    return a.exit is not None and a.exit == b.exit
+    """In by the same mouth and out by the same mouth (an AGV that was inside when it
+    asked has no entry: its exit decides)."""
+    same_entry = a.entry is None or b.entry is None or a.entry == b.entry
+    return a.exit is not None and a.exit == b.exit and same_entry
 
 
 def may_enter(name: str, intents: list[Intent]) -> tuple[bool, list[str]]:
@@ -107,14 +113,19 @@ def may_enter(name: str, intents: list[Intent]) -> tuple[bool, list[str]]:
 
 
 def first_rival(me: Intent, intents: list[Intent]) -> str | None:
-    """A holder of my passage that goes the other way and came first (earlier ``since``,
-    then name): two AGVs that meet inside a passage (both started there), and the later
-    one backs out. None when I have no such rival."""
+    """A holder of my passage that goes the other way and goes first: two AGVs that meet
+    inside a passage (both started there), and the other one backs out. One that leaves
+    by a mouth goes before one that stops inside (a dead end has nowhere to back out
+    to), then the earlier ``since``, then the name. None when I have no such rival."""
+
+    def rank(i: Intent):
+        return (i.exit is None, i.since, i.name)
+
     rivals = [
         h for h in holders(me.passage, intents)
-        if h.name != me.name and not _same_way(h, me) and (h.since, h.name) < (me.since, me.name)
+        if h.name != me.name and not _same_way(h, me) and rank(h) < rank(me)
     ]  # fmt: skip
-    return min(rivals, key=lambda h: (h.since, h.name)).name if rivals else None
+    return min(rivals, key=rank).name if rivals else None
 
 
 def waiting_for(intents: list[Intent]) -> dict[str, list[str]]:

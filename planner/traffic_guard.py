@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from planner.costmap import Costmap
 from planner.dwa import DwaConfig
 from planner.grid_map import Point
-from planner.passages import NONE, Crossing, Passages
+from planner.passages import Crossing, Passages
 from planner.traffic import (
     BACK,
     CLEAR,
@@ -62,8 +62,10 @@ class TrafficGuard:
         safety = costmap.clearance.safety_distance
         braking = dwa.max_speed**2 / (2 * dwa.max_accel)
         self.request_distance = braking + (max(WAIT_BACK) + 2) * safety
+        self.stop_distance = braking + WAIT_BACK[0] * safety  # closer: stop before asking
         self.release_distance = WAIT_BACK[0] * safety
         self._claim: tuple[int, int | None] | None = None
+        self._entry: int | None = None
         self._since = 0
         self._phase = CLEAR
         self._hold: Point | None = None
@@ -84,9 +86,6 @@ class TrafficGuard:
         shared = [[round(x, 2), round(y, 2)] for x, y in [position, *route[1:ROUTE_POINTS]]]
         along = _projection(route, position)
         crossing = self.passages.first_crossing(route, self.request_distance, along)
-        here = self.passages.at(position)
-        if here != NONE and (crossing is None or crossing.passage != here):
-            crossing = Crossing(here, 0.0, 0.0, None)  # inside a passage off the route
         if self._leaving(position, crossing):
             crossing = Crossing(self._claim[0], 0.0, 0.0, self._claim[1])
         if crossing is None:
@@ -95,9 +94,10 @@ class TrafficGuard:
         claim = (crossing.passage, crossing.exit)
         if claim != self._claim:
             self._claim, self._since, self._phase, self._hold = claim, tick, REQUEST, None
+            self._entry = crossing.entry
         intent = Intent(
             name, tick, self._phase, crossing.passage, crossing.exit, self._since,
-            round(crossing.enter_at, 2), stalled, shared,
+            round(crossing.enter_at, 2), stalled, shared, entry=self._entry,
         )  # fmt: skip
         if crossing.enter_at <= 0.0 or self._phase == GO:
             rival = first_rival(intent, intents)
@@ -110,7 +110,11 @@ class TrafficGuard:
             return self._decision(intent, self._hold, [rival])
         seen = next((i for i in intents if i.name == name), None)
         if seen is None or (seen.passage, seen.exit, seen.since) != (*claim, self._since):
-            return self._decision(intent)  # the fleet has not seen this claim yet
+            if crossing.enter_at > self.stop_distance:
+                return self._decision(intent)  # the fleet has not seen this claim yet
+            # asked this close (after a replan, or from the start): stop outside first
+            self._hold = self._hold or self._waiting_place(route, along + crossing.enter_at)
+            return self._decision(intent, self._hold)
         allowed, blockers = may_enter(name, intents)
         if allowed:
             waited = self._phase in HELD
@@ -127,12 +131,19 @@ class TrafficGuard:
 
     def _leaving(self, position: Point, crossing: Crossing | None) -> bool:
         """Just out of the passage it held: it keeps it until its body is clear of the
-        mouth (``WAIT_BACK[0]`` safety distances), where the waiting AGVs are not."""
+        mouth (``WAIT_BACK[0]`` safety distances), where the waiting AGVs are not, unless
+        another passage starts before that."""
         if self._phase != GO or self._claim is None:
             return False
-        if crossing is not None and crossing.passage == self._claim[0]:
+        if crossing is not None and (
+            crossing.passage == self._claim[0] or crossing.enter_at <= self.release_distance
+        ):
             return False
         return self.passages.distance_to(position, self._claim[0]) < self.release_distance
+
+    def replanned(self) -> None:
+        """A new route: the waiting place is chosen again on it."""
+        self._hold = None
 
     def _decision(self, intent: Intent, hold=None, blockers=(), rejoin=False) -> TrafficDecision:
         if intent.phase not in HELD:
@@ -159,7 +170,7 @@ class TrafficGuard:
         mouths = {m: c for m, c in self.passages.mouths(crossing.passage).items()}
         mouths.pop(crossing.exit, None)
         if not mouths:
-            return position
+            return position  # a dead end behind: the rule makes the other one back out
         mouth = min(mouths.values(), key=lambda c: math.dist(c, position))
         inner = self.passages.nearest_cell_centre(mouth, crossing.passage)
         away = (mouth[0] - inner[0], mouth[1] - inner[1])
@@ -180,7 +191,9 @@ class TrafficGuard:
         hold = self._hold or self._waiting_place(route, enter_at)
         entrance, _ = _point_along(route, enter_at)
         away = (2 * hold[0] - entrance[0], 2 * hold[1] - entrance[1])
-        return away if self._room_at(away) and self._room_at(hold) else hold
+        steps = [(hold[0] + (away[0] - hold[0]) * t / 8, hold[1] + (away[1] - hold[1]) * t / 8)
+                 for t in range(9)]  # fmt: skip
+        return away if all(self._room_at(p) for p in steps) else hold
 
     def _room_at(self, point: Point) -> bool:
         grid = self.costmap.grid

@@ -1,10 +1,13 @@
 """The traffic layer: passages found from the costmap, the first-come rule, and fleets
-that take turns in passages one AGV wide (in process; over Zenoh in test_fleet_zenoh)."""
+that take turns in passages one AGV wide (in process; over Zenoh in test_traffic_zenoh)."""
 
 from __future__ import annotations
 
 from bridge import keys
+from bridge.messages import AgvCommand
+from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.inprocess import run_in_process, run_recorded
+from fleet.runtime.world import World
 from fleet.scenario import load_scenario, parse_scenario
 from planner.clearance import Clearance
 from planner.costmap import Costmap
@@ -110,7 +113,6 @@ def test_an_agv_stopping_inside_goes_alone_and_yielding_agvs_still_queue():
     backed_off = [claim("x", YIELD, 2, 1), claim("y", WAIT, 1, 2)]
     assert may_enter("x", backed_off) == (True, [])  # a yielding AGV is not a holder
     assert may_enter("y", backed_off) == (False, ["x"])
-    assert may_enter("z", backed_off) == (False, [])  # no claim yet
 
 
 # --- fleets ---------------------------------------------------------------------------
@@ -216,3 +218,34 @@ def test_first_rival_is_the_earlier_holder_going_the_other_way():
     assert first_rival(me, [me, claim("x", GO, 2, 5)]) is None  # I came first: x backs out
     assert first_rival(me, [me, claim("x", GO, 1, 1)]) is None  # same way: a convoy
     assert first_rival(me, [me, claim("x", WAIT, 2, 1)]) is None  # not inside
+
+
+def test_a_convoy_comes_in_and_goes_out_by_the_same_mouths():
+    inside = Intent("h", 10, GO, 0, exit=3, since=0, entry=1)
+    merging = Intent("m", 10, WAIT, 0, exit=3, since=1, entry=2)  # from a side arm
+    behind = Intent("b", 10, WAIT, 0, exit=3, since=1, entry=1)
+    assert may_enter("m", [inside, merging]) == (False, ["h"])
+    assert may_enter("b", [inside, behind]) == (True, [])
+
+
+def test_every_agv_finds_the_same_passages_whatever_its_own_radius():
+    mid = 3.75
+    text = corridor_swap(3, [("a", (2.0, mid), (18.0, mid)), ("b", (18.0, mid), (2.0, mid))])
+    text = text.replace('name = "b"', 'name = "b"\nradius = 0.2')
+    scenario = parse_scenario(text)
+    guards = [AgvNode(scenario, name).guard for name in ("a", "b")]
+    assert guards[0].passages is guards[1].passages
+    assert scenario.agv("a").radius != scenario.agv("b").radius
+
+
+def test_the_world_refuses_an_intent_from_a_later_tick():
+    mid = 3.75
+    scenario = parse_scenario(corridor_swap(3, [("a", (2.0, mid), (18.0, mid))]))
+    world = World(scenario)
+    world.first_tick()
+    forged = Intent("a", 0, GO, 0, exit=1, since=10**6)
+    world.advance({"a": AgvCommand("a", 1, 0.0, 0.0, 0.0, intent=forged)})
+    assert "a" not in world.intents and world.records["a"].refused == 1
+    honest = Intent("a", 0, REQUEST, 0, exit=1, since=1)
+    world.advance({"a": AgvCommand("a", 2, 0.0, 0.0, 0.0, intent=honest)})
+    assert world.intents["a"].phase == REQUEST

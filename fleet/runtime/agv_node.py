@@ -18,6 +18,8 @@ from bridge import keys
 from bridge.messages import AgvCommand, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
 from planner.agv_status import FAILED, FINISHED
+from planner.clearance import Clearance
+from planner.costmap import Costmap
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
 from planner.motion import world_velocity
@@ -50,7 +52,7 @@ class AgvNode:
         self.spec = scenario.agv(name)
         self.name = name
         self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
-        self.guard = traffic_guard(self.controller)
+        self.guard = traffic_guard(scenario, self.controller)
         self._parked: frozenset[str] = frozenset()
         self._started = False
 
@@ -90,12 +92,15 @@ class AgvNode:
             )
             if decision.rejoin:  # it waited off its route: plan the way in from here
                 plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), "traffic")
+                self.guard.replanned()
         step = self.controller.step(
             pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick),
             hold=decision.hold if decision else None,
         )  # fmt: skip
         if step.plan is not None:
             plan_msg = self._plan_msg(tick, step.plan, "replan")
+            if self.guard is not None:
+                self.guard.replanned()
         command = self._command(tick, step.command, step.status, step.target)
         command.plan_time_ms = step.plan_time_s * 1e3
         command.start_heading = start_heading
@@ -157,12 +162,17 @@ class AgvNode:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
 
 
-def traffic_guard(controller: FusionController) -> TrafficGuard | None:
+def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGuard | None:
     """The traffic guard of an AGV of the default profile that follows a global route
-    (the paper profile treats other AGVs only as moving discs, as the paper does)."""
+    (the paper profile treats other AGVs only as moving discs, as the paper does).
+
+    Every guard of a run finds the passages for the same clearance, the largest of the
+    fleet's, so that a passage id means the same passage to every AGV."""
     if controller.costmap is None or controller.config.algorithm == "dwa":
         return None
-    return TrafficGuard(controller.costmap, controller.config.dwa)
+    fleet = [a.config.clearance for a in scenario.agvs]
+    widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))
+    return TrafficGuard(Costmap.for_grid(scenario.grid, widest), controller.config.dwa)
 
 
 def plan_message(name: str, tick: Tick | None, plan: PlanResult, reason: str) -> PlanMsg:

@@ -154,6 +154,10 @@ class World:
         if status in FINISHED or intent is None or intent.name != name:
             self.intents.pop(name, None)
             return
+        if intent.since > self.tick or any(len(p) != 2 for p in intent.route):
+            self._refuse(name, "a traffic intent asked in a later tick or with malformed points")
+            self.intents.pop(name, None)
+            return
         intent.tick = self.tick
         intent.route = intent.route[:ROUTE_POINTS]  # the tick carries every AGV's: bounded
         intent.waits_for = [n for n in intent.waits_for[: len(self.records)] if n in self.records]
