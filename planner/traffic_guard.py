@@ -32,6 +32,7 @@ from planner.traffic import (
     Intent,
     first_rival,
     may_enter,
+    queue,
     stuck_holders,
 )  # fmt: skip
 
@@ -41,6 +42,8 @@ WAIT_BACK = (3.0, 4.0, 6.0)
 ASIDE = (2.0, 1.5, 1.0, 0.0)
 """... and this many safety distances to the right of the route (the first with room):
 AGVs leaving the passage along the route pass it."""
+QUEUE_GAP = 2.0
+"""Safety distances between the waiting places of AGVs queued on the same side."""
 ROUTE_POINTS = 5
 """Route points ahead shared in an intent (the AGV's position, then key nodes)."""
 
@@ -121,7 +124,8 @@ class TrafficGuard:
             intent.phase = self._phase = GO
             return self._decision(intent, rejoin=waited)
         if self._hold is None:
-            self._hold = self._waiting_place(route, along + crossing.enter_at)
+            ahead = _ahead_on_my_side(intent, intents)
+            self._hold = self._waiting_place(route, along + crossing.enter_at, ahead)
         if stuck_holders(crossing.passage, intents) and self._phase not in (YIELD, BACK):
             self._hold = self._further_back(route, along + crossing.enter_at)
             intent.phase = self._phase = YIELD
@@ -151,11 +155,14 @@ class TrafficGuard:
         intent.waits_for = sorted(blockers)
         return TrafficDecision(intent, hold, rejoin)
 
-    def _waiting_place(self, route: list[Point], enter_at: float) -> Point:
-        """``wait_back`` before the passage (``enter_at`` m along the route), moved to the
-        right of the route where free."""
+    def _waiting_place(self, route: list[Point], enter_at: float, ahead: int = 0) -> Point:
+        """``WAIT_BACK`` before the passage (``enter_at`` m along the route), and
+        ``QUEUE_GAP`` further for each of the ``ahead`` AGVs queued before it on its side
+        (a crowd at the mouth blocks the AGVs coming out), moved to the right of the
+        route where free."""
         safety = self.costmap.clearance.safety_distance
         for back in WAIT_BACK:
+            back += ahead * QUEUE_GAP
             point, heading = _point_along(route, max(0.0, enter_at - back * safety))
             right = (math.sin(heading), -math.cos(heading))
             for aside in ASIDE:
@@ -215,6 +222,15 @@ def _point_along(route: list[Point], at: float) -> tuple[Point, float]:
         travelled += length
     a, b = route[-2] if len(route) > 1 else route[0], route[-1]
     return tuple(b), math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def _ahead_on_my_side(me: Intent, intents: list[Intent]) -> int:
+    """How many AGVs wait for my passage before me and come from my side (my entry)."""
+    return sum(
+        1 for i in queue(me.passage, intents)
+        if i.name != me.name and i.entry == me.entry and (i.since, i.name) < (me.since, me.name)
+        and i.phase in HELD
+    )  # fmt: skip
 
 
 def _projection(route: list[Point], position: Point) -> float:
