@@ -45,6 +45,7 @@ from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point
 from planner.local_behaviour import local_behaviour
+from planner.parked_discs import blocking_cells
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
 from planner.route_check import blocked_point
@@ -160,7 +161,9 @@ class FusionController:
                 pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
         return pose, plan
 
-    def _plan_from(self, position: Point) -> PlanResult | None:
+    def _plan_from(self, position: Point, avoid: list[Cell] | None = None) -> PlanResult | None:
+        """Plan from ``position`` on what is known; round the cells ``avoid`` too (default
+        profile) when that leaves a way."""
         if self.config.algorithm == "dwa":
             self.targets = [self.goal]
             self.target_index = 0
@@ -170,19 +173,12 @@ class FusionController:
             known = self.costmap.grid
         else:
             known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
-        try:
-            plan = plan_global(
-                known,
-                position,
-                self.goal,
-                _GLOBAL_ALGORITHM[self.config.algorithm],
-                profile=self.config.profile,
-                clearance=self.config.clearance,
-                costmap=self.costmap,
-            )
-        except MapError as err:  # e.g. standing in a cell now known to be blocked
-            plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
-            self.failure = str(err)
+        plan = None
+        if avoid and self.costmap is not None:
+            around = self.costmap.with_blocked(avoid)
+            plan = self._search(around.grid, around, position)
+        if plan is None or not plan.found:
+            plan = self._search(known, self.costmap, position)
         if not plan.found:
             self.failure = self.failure or "no path to the goal on the known map"
             self.status = "failed"
@@ -195,6 +191,21 @@ class FusionController:
         self.targets[-1] = self.goal
         self.target_index = 0
         return plan
+
+    def _search(self, known: GridMap, costmap: Costmap | None, position: Point) -> PlanResult:
+        try:
+            return plan_global(
+                known,
+                position,
+                self.goal,
+                _GLOBAL_ALGORITHM[self.config.algorithm],
+                profile=self.config.profile,
+                clearance=self.config.clearance,
+                costmap=costmap,
+            )
+        except MapError as err:  # e.g. standing in a cell now known to be blocked
+            self.failure = str(err)
+            return PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
 
     def see(self, cells) -> bool:
         """Temporary obstacle cells inside the sensing radius; True when any is new."""
@@ -245,7 +256,7 @@ class FusionController:
         if self.status == "failed":
             return _step(stop, self.status, plan=plan)
         if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
-            plan = self._on_stall(position, now)
+            plan = self._on_stall(position, now, moving)
             if self.status == "failed":
                 return _step(stop, self.status, plan=plan)
             if self._recovery is not None:
@@ -298,8 +309,9 @@ class FusionController:
         self._best_remaining = self.remaining(position) if self.targets else math.inf
         return plan
 
-    def _on_stall(self, position: Point, now: float) -> PlanResult | None:
-        """No progress for ``progress_window``: replan (paper) or the next recovery (default)."""
+    def _on_stall(self, position: Point, now: float, moving) -> PlanResult | None:
+        """No progress for ``progress_window``: replan (paper) or the next recovery (default,
+        whose replans go round the discs parked on the route where there is a way)."""
         if not self.behaviour.recover:
             plan = self._plan_from(position)
             self._best_remaining, self._best_time = math.inf, now
@@ -314,13 +326,25 @@ class FusionController:
             return None
         kind = RECOVERIES[self._recoveries_done]
         self._recoveries_done += 1
-        plan = self._plan_from(position) if kind == "replan" else None
+        plan = (
+            self._plan_from(position, self._parked_on_route(position, moving))
+            if kind == "replan"
+            else None
+        )
         if self.targets:
             self._best_remaining = self.remaining(position)
         self._best_time = now + DURATION_S[kind]
         if DURATION_S[kind] > 0:
             self._recovery = Recovery(kind, now + DURATION_S[kind])
         return plan
+
+    def _parked_on_route(self, position: Point, moving) -> list[Cell]:
+        """The cells of the discs parked on the remaining route, except the AGV's and the
+        goal's."""
+        route = [position, *self.targets[self.target_index :]]
+        cells = blocking_cells(self.grid, moving, route, self.config.dwa.radius)
+        own = (self.grid.cell_of(position), self.grid.cell_of(self.goal))
+        return [c for c in cells if c not in own]
 
     def _advance_target(self, position: Point) -> None:
         last = len(self.targets) - 1

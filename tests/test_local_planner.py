@@ -30,6 +30,7 @@ from planner.fusion import FusionConfig
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
+from planner.parked_discs import blocking_cells, covered_cells
 from planner.route_check import blocked_point
 
 DATA = Path(__file__).parent / "data"
@@ -228,3 +229,31 @@ def test_the_planner_profile_is_a_scenario_key():
     assert parse_scenario(text.format("default")).agvs[0].config.profile == "default"
     with pytest.raises(ScenarioError, match="profile"):
         parse_scenario(text.format("fast"))
+
+
+def test_a_recovery_replan_goes_round_a_disc_parked_in_the_route_where_there_is_a_way():
+    # two ways through the wall: a 1-cell gap at x = 6 (the shorter) and an open end at
+    # x = 11..13; a walker has parked in the gap. A replan that does not mark it draws the
+    # same route through it again, and the AGV fails after the recoveries.
+    grid = parse_text_grid("\n".join(["." * 14, "#" * 6 + "." + "#" * 4 + "...", "." * 14]))
+    parked = MovingObstacle("parked", 0.45, ((6.5, 1.5),), 0.0)
+    summary, states = run(
+        scenario(grid, (4.5, 0.5), (4.5, 2.5), dwa=REALISTIC, moving=[parked], time_limit=90)
+    )
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+    assert max(s.x for s in states) > 10.5  # through the open end
+
+
+def test_only_discs_at_rest_on_the_route_are_marked_for_a_replan():
+    grid = parse_text_grid("\n".join(["." * 10] * 3))
+    route = [(0.5, 1.5), (9.5, 1.5)]
+    discs = np.array(
+        [
+            [4.5, 1.5, 0.0, 0.0, 0.4],  # parked on the route: its cell
+            [7.5, 1.5, 0.5, 0.0, 0.4],  # on the route but walking
+            [2.5, 0.2, 0.0, 0.0, 0.1],  # parked 1.3 m off the route: room to pass
+        ]
+    )
+    assert blocking_cells(grid, discs, route, 0.3) == [(4, 1)]
+    assert covered_cells(grid, (5.0, 1.5), 0.4) == [(4, 1), (5, 1)]
