@@ -62,6 +62,7 @@ import numpy as np
 from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
+from planner.yielding import parked_clearance, yield_horizon
 
 Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
@@ -394,6 +395,8 @@ class DwaPlanner:
         previous: Command | None = None,
         approach: bool = False,
         segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
+        route: list[tuple[float, float]] | None = None,
+        walkers: np.ndarray | None = None,
     ) -> DwaResult:
         """One control cycle from ``pose`` with current ``command`` towards the local target.
 
@@ -405,6 +408,9 @@ class DwaPlanner:
         ``approach``: the final approach, where the dist term is replaced by
         nearness to the target (goals in docks and pockets have little clearance).
         ``segment``: the global route's segment to the target, for the ``on_route`` term.
+        ``route``: the remaining global route from the AGV, along which head-on
+        ``walkers`` (rows as ``moving``: the discs that do not avoid the AGV) are
+        predicted, to get out of their way early (``planner.yielding``).
         """
         cfg = self.config
         field = self.distance_field
@@ -421,6 +427,10 @@ class DwaPlanner:
                 xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
             )
         mask = admissible_mask(cfg, commands, clearance)
+        if self.behaviour.yield_early and walkers is not None and len(walkers):
+            ends = (xs[:, -1], ys[:, -1])
+            walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+            mask = self._clear_of_walkers_later(mask, command, ends, walkers, route)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
             room = math.dist(pose[:2], target_xy)
@@ -470,6 +480,16 @@ class DwaPlanner:
             best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+    def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
+        """``mask`` narrowed to the samples whose end point no disc reaches before the
+        yield horizon (``planner.yielding``), when any admissible one is such."""
+        cfg = self.config
+        speed = math.hypot(command[0], command[1])
+        horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
+        later = parked_clearance(*ends, discs, route, cfg.steps * cfg.dt, horizon, cfg.radius)
+        clear = mask & (later > 0.0)
+        return clear if clear.any() else mask
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""

@@ -26,7 +26,9 @@ driven within the omega and alpha limits; every cycle in which new obstacles
 were sensed, a check of the remaining route against them and an immediate
 replan when they block it; a final approach scored by nearness to the goal;
 arrival only when stopped inside the tolerance; bounded recoveries
-(``planner/recovery.py``) and then ``failed`` with the reason.
+(``planner/recovery.py``), whose replans go round discs parked on the route,
+and then ``failed`` with the reason; a turn on the spot towards a target
+behind; early yielding to walkers (``planner/yielding.py``, in DWA).
 """
 
 from __future__ import annotations
@@ -59,6 +61,12 @@ GLOBAL_ALGORITHM = _GLOBAL_ALGORITHM
 
 CALM_WINDOWS = 3
 """Progress windows without a stall after which the recoveries start again from the first."""
+
+BEHIND = math.radians(120.0)
+"""A target this far off the body's heading is behind it: turn round on the spot first."""
+
+PARKED_ROUNDS = 3
+"""How many times a recovery replan goes round the discs parked on the plan it drew."""
 
 
 @dataclass(frozen=True)
@@ -161,9 +169,9 @@ class FusionController:
                 pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
         return pose, plan
 
-    def _plan_from(self, position: Point, avoid: list[Cell] | None = None) -> PlanResult | None:
-        """Plan from ``position`` on what is known; round the cells ``avoid`` too (default
-        profile) when that leaves a way."""
+    def _plan_from(self, position: Point, moving: np.ndarray | None = None) -> PlanResult | None:
+        """Plan from ``position`` on what is known; with ``moving`` (default profile), round
+        the discs parked on the route too where that leaves a way."""
         if self.config.algorithm == "dwa":
             self.targets = [self.goal]
             self.target_index = 0
@@ -173,12 +181,9 @@ class FusionController:
             known = self.costmap.grid
         else:
             known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
-        plan = None
-        if avoid and self.costmap is not None:
-            around = self.costmap.with_blocked(avoid)
-            plan = self._search(around.grid, around, position)
-        if plan is None or not plan.found:
-            plan = self._search(known, self.costmap, position)
+        plan = self._search(known, self.costmap, position)
+        if plan.found and moving is not None and self.costmap is not None:
+            plan = self._round_parked(plan, position, moving)
         if not plan.found:
             self.failure = self.failure or "no path to the goal on the known map"
             self.status = "failed"
@@ -226,14 +231,17 @@ class FusionController:
         command: tuple[float, float, float],
         now: float,
         moving: np.ndarray | None = None,
+        walkers: np.ndarray | None = None,
     ) -> ControlStep:
-        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]."""
+        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]:
+        every other AGV and moving obstacle; ``walkers`` those of them that do not avoid
+        the AGV (the default profile gets out of their way early)."""
         t0 = time.perf_counter()
-        out = self._step(pose, command, now, moving)
+        out = self._step(pose, command, now, moving, walkers)
         self._previous = command
         return replace(out, plan_time_s=time.perf_counter() - t0)
 
-    def _step(self, pose, command, now, moving) -> ControlStep:
+    def _step(self, pose, command, now, moving, walkers) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
         if self.status in ("arrived", "failed"):
             return _step(stop, self.status)
@@ -260,7 +268,7 @@ class FusionController:
             if self.status == "failed":
                 return _step(stop, self.status, plan=plan)
             if self._recovery is not None:
-                return self._step(pose, command, now, moving)
+                return self._step(pose, command, now, moving, walkers)
         self._advance_target(position)
         target = self.targets[self.target_index]
         final = self.target_index == len(self.targets) - 1
@@ -270,9 +278,14 @@ class FusionController:
             and final
             and math.dist(position, target) <= self.config.approach_distance
         )
+        turn = self._turn_round(pose, command, target, moving)
+        if turn is not None:
+            return _step(turn, "driving", target)
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
             approach=approach, segment=(self._segment_start(), target),
+            route=[position, *self.targets[self.target_index :]],
+            walkers=walkers,
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
@@ -293,6 +306,18 @@ class FusionController:
             cmd = braking_command(self.config.dwa, command)
         self._best_time = now  # turning on the spot is progress for the progress checker
         return _step(cmd, "driving", first)
+
+    def _turn_round(self, pose, command, target, moving) -> tuple[float, float, float] | None:
+        """Default profile, an AGV that cannot reverse and a target behind it: the turn on
+        the spot towards it (DWA's arcs only circle, turning the body while driving on),
+        unless a walker is coming; None otherwise."""
+        if not self.behaviour.turn_round or self.config.dwa.min_vx < 0:
+            return None
+        bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
+        error = float(wrap_angle(bearing - pose[2]))
+        if abs(error) <= BEHIND or self.dwa.threatened(pose, moving):
+            return None
+        return turn_command(self.config.dwa, error, command)
 
     def _check_route(self, position: Point) -> PlanResult | None:
         """Replan at once when newly sensed obstacles block the remaining route."""
@@ -326,11 +351,7 @@ class FusionController:
             return None
         kind = RECOVERIES[self._recoveries_done]
         self._recoveries_done += 1
-        plan = (
-            self._plan_from(position, self._parked_on_route(position, moving))
-            if kind == "replan"
-            else None
-        )
+        plan = self._plan_from(position, moving) if kind == "replan" else None
         if self.targets:
             self._best_remaining = self.remaining(position)
         self._best_time = now + DURATION_S[kind]
@@ -338,13 +359,24 @@ class FusionController:
             self._recovery = Recovery(kind, now + DURATION_S[kind])
         return plan
 
-    def _parked_on_route(self, position: Point, moving) -> list[Cell]:
-        """The cells of the discs parked on the remaining route, except the AGV's and the
-        goal's."""
-        route = [position, *self.targets[self.target_index :]]
-        cells = blocking_cells(self.grid, moving, route, self.config.dwa.radius)
+    def _round_parked(self, plan: PlanResult, position: Point, moving) -> PlanResult:
+        """``plan``, or a plan round the discs parked on it (and on each plan round them,
+        up to ``PARKED_ROUNDS`` times) when there is one."""
         own = (self.grid.cell_of(position), self.grid.cell_of(self.goal))
-        return [c for c in cells if c not in own]
+        marked: set[Cell] = set()
+        for _ in range(PARKED_ROUNDS):
+            route = [position, *plan.key_nodes[1:]]
+            cells = set(blocking_cells(self.grid, moving, route, self.config.dwa.radius))
+            cells -= {*own, *marked}
+            if not cells:
+                break
+            marked |= cells
+            around = self.costmap.with_blocked(marked)
+            rounded = self._search(around.grid, around, position)
+            if not rounded.found:
+                break
+            plan = rounded
+        return plan
 
     def _advance_target(self, position: Point) -> None:
         last = len(self.targets) - 1

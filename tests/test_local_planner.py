@@ -26,7 +26,7 @@ from fleet.scenario import (
 )
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
-from planner.fusion import FusionConfig
+from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
@@ -257,3 +257,34 @@ def test_only_discs_at_rest_on_the_route_are_marked_for_a_replan():
     )
     assert blocking_cells(grid, discs, route, 0.3) == [(4, 1)]
     assert covered_cells(grid, (5.0, 1.5), 0.4) == [(4, 1), (5, 1)]
+
+
+# a 1-cell lane with two 2-cell bays on its north side
+BAYS = parse_text_grid("\n".join(["#" * 14, "#####..###..##", "." * 14, "#" * 14]))
+
+
+@pytest.mark.parametrize(("speed", "start_at"), [(0.4, 5.0), (0.6, 10.0)])
+def test_a_walker_head_on_along_the_route_is_let_by_from_a_bay(speed, start_at):
+    # the walker walks the whole lane towards the AGV and avoids nothing; at Table 1's
+    # 0.2 m/s² the AGV must be in a bay before DWA's 3 s horizon would see the walker
+    walker = MovingObstacle("head-on", 0.35, ((0.5, 1.5), (13.5, 1.5)), speed, "once", start_at)
+    summary, states = run(scenario(BAYS, (13.5, 1.5), (0.5, 1.5), moving=[walker], time_limit=150))
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+    assert max(s.y for s in states) > 2.1  # it stood in a bay, off the walker's line
+
+
+def test_a_target_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
+    grid = parse_text_grid("\n".join(["." * 12] * 5))
+    speeds = {}
+    for profile in ("default", "paper"):
+        controller = FusionController(grid, (1.5, 2.5), FusionConfig(profile=profile))
+        controller.start((10.5, 2.5, math.pi))
+        controller.step((10.5, 2.5, math.pi), (0.0, 0.0, 0.0), 0.0)
+        command = (0.3, 0.0, 0.0)  # driving east, away from the goal
+        for k in range(3):
+            command = controller.step((9.5, 2.5, 0.0), command, 0.1 * (k + 1)).command
+        speeds[profile] = math.hypot(command[0], command[1])
+        assert command[2] < 0  # both turn (clockwise: the shorter way from 0 to pi here)
+    assert speeds["default"] == pytest.approx(0.3 - 3 * 0.02)  # braking at a_max
+    assert speeds["paper"] > 0.3  # DWA's arcs speed up, circling

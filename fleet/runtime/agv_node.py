@@ -75,7 +75,9 @@ class AgvNode:
             if pose[2] != me.theta:
                 start_heading = float(pose[2])
         self._sense(tick, pose)
-        step = self.controller.step(pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick))
+        step = self.controller.step(
+            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick), _walkers(tick)
+        )
         if step.plan is not None:
             plan_msg = self._plan_msg(tick, step.plan, "replan")
         command = self._command(tick, step.command, step.status, step.target)
@@ -123,11 +125,16 @@ class AgvNode:
         x, y, theta, vx, vy, omega, radius = fields.T
         velocity = world_velocity(theta, vx, vy, omega, self.scenario.dt)
         agvs = np.column_stack((x, y, velocity, radius))
-        moving = [(o.x, o.y, o.vx, o.vy, o.radius) for o in tick.moving]
-        return np.vstack((agvs, np.array(moving, dtype=float).reshape(-1, 5)))
+        return np.vstack((agvs, _walkers(tick)))
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
+
+
+def _walkers(tick: Tick) -> np.ndarray:
+    """The moving obstacles as (x, y, vx, vy, radius) rows: discs that do not avoid an AGV."""
+    moving = [(o.x, o.y, o.vx, o.vy, o.radius) for o in tick.moving]
+    return np.array(moving, dtype=float).reshape(-1, 5)
 
 
 def plan_message(name: str, tick: Tick | None, plan: PlanResult, reason: str) -> PlanMsg:
