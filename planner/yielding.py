@@ -25,17 +25,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from planner.grid_map import Point
 from planner.route_check import route_samples
 
 if TYPE_CHECKING:  # planner.dwa imports this module
     from planner.dwa import DwaConfig
 
-Point = tuple[float, float]
+YIELD_MARGIN = 2.0
+"""The time to brake and step aside, this many times over: a refuge is not always beside
+the AGV."""
 
 SWEEP_STEP = 0.1  # m: spacing of the points a sweep is checked at
 ON_ROUTE = 0.5  # m: a disc centre this near the route walks along it
-YIELD_MARGIN = 2.0  # the time to brake and step aside, this many times over: a refuge is not
-# always beside the AGV
 AGAINST = math.radians(45.0)  # rad: ... if it walks within this of the route's reverse
 
 
