@@ -11,6 +11,9 @@ arrival time, median RMS jerk per vehicle (world-frame, over the drive, as
 ``recordings.analysis`` defines it) and the wall time. Then the default
 fusion's targets: 100 % success, 0 collisions, median driven/shortest <=
 1.15, RMS jerk <= 0.6 m/s³ at Table-1 limits; a MISS never fails the run.
+
+``--seeds 8,40,42`` runs just those episodes and prints one line for each
+(status, arrival, collisions, driven/shortest), to iterate on them.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.nav_episodes import Episode, episodes
+from benchmarks.nav_episodes import Episode, episodes, make_episode
 from fleet.runtime.inprocess import run_in_process
 from recordings.analysis import world_velocity
 
@@ -86,7 +89,7 @@ def table(results: list[dict], count: int) -> str:
     header = ("variant", "success", "collided", "driven/shortest", "arrival s",
               "jerk T1", "jerk real", "wall s")  # fmt: skip
     rows = [header]
-    for label, _, _ in VARIANTS:
+    for label in (v[0] for v in VARIANTS if v[0] in by):
         rs = by[label]
         ok = [r for r in rs if r["status"] == "arrived" and r["collisions"] == 0]
         rows.append(
@@ -123,14 +126,26 @@ def targets(results: list[dict], count: int) -> list[str]:
     return [f"{'PASS' if good else 'MISS'} fusion (default): {text}" for text, good in checks]
 
 
+def selected(seeds: str) -> list[Episode]:
+    """The episodes of the comma-separated ``seeds``; a seed without one is an error."""
+    out = []
+    for seed in (int(s) for s in seeds.split(",")):
+        episode = make_episode(seed)
+        if episode is None:
+            raise SystemExit(f"seed {seed} has no episode: its map leaves the body no way")
+        out.append(episode)
+    return out
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--episodes", type=int, default=100)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--variants", default="all", help="'all' or a comma list of labels")
+    parser.add_argument("--seeds", help="a comma list of episode seeds, in place of --episodes")
     args = parser.parse_args()
     chosen = [v for v in VARIANTS if args.variants == "all" or v[0] in args.variants.split(",")]
-    eps = episodes(args.episodes)
+    eps = selected(args.seeds) if args.seeds else episodes(args.episodes)
     jobs = [(e, *v) for e in eps for v in chosen]
     t0 = time.perf_counter()
     with multiprocessing.get_context("spawn").Pool(max(1, min(args.workers, 2))) as pool:
@@ -150,12 +165,15 @@ def main() -> None:
     print(table(results, len(eps)))
     for line in targets(results, len(eps)):
         print(line)
-    failures = [r for r in results if r["variant"] == VARIANTS[0][0]]
-    failures = [r for r in failures if r["status"] != "arrived" or r["collisions"]]
-    for r in failures:
+    shown = [r for r in results if args.seeds or r["variant"] == VARIANTS[0][0]]
+    if not args.seeds:  # the whole benchmark: only the default fusion's failures
+        shown = [r for r in shown if r["status"] != "arrived" or r["collisions"]]
+    for r in shown:
+        arrival = f" at {r['arrival']:.1f} s" if r["status"] == "arrived" else ""
         print(
-            f"  default fusion seed {r['seed']} ({r['vehicle']}, {r['kind']}): {r['status']}"
-            f"{' ' + r['failure'] if r['failure'] else ''}, {r['collisions']} collision(s)"
+            f"  {r['variant']} seed {r['seed']} ({r['vehicle']}, {r['kind']}): {r['status']}"
+            f"{arrival}{' ' + r['failure'] if r['failure'] else ''}, "
+            f"{r['collisions']} collision(s), driven/shortest {r['ratio']:.2f}"
         )
 
 

@@ -62,6 +62,7 @@ import numpy as np
 from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
+from planner.yielding import parked_clearance, yield_horizon
 
 Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
@@ -433,27 +434,17 @@ def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarra
     )
 
 
-def steady_choice(
-    score: np.ndarray, change: np.ndarray, tolerance: float, speed_change: np.ndarray
-) -> int:
-    """The sample of least ``change`` among those scoring within ``tolerance`` of the best
-    that change the speed the way the best does (up, down or not).
+def steady_choice(score: np.ndarray, change: np.ndarray, tolerance: float) -> int:
+    """The sample of least ``change`` among those scoring within ``tolerance`` of the best.
 
     ``tolerance`` is a fraction of the scores' spread. The normalised scores
     of neighbouring samples differ by little, so the plain argmax hops
     between them every cycle and the acceleration flips; preferring the
     steadiest near-best sample keeps the acceleration unless a clearly
-    better command exists. The speed's direction of change follows the best
-    sample: the speed term's differences are far inside the tolerance, and
-    without it an AGV that had slowed down (at a narrow entrance) kept its
-    crawl through a whole corridor.
+    better command exists.
     """
     top = float(score.max())
-    way = np.sign(np.round(speed_change, 9))
-    best_way = way[int(np.argmax(score))]
-    near = np.flatnonzero(
-        (score >= top - tolerance * (top - float(score.min()))) & (way == best_way)
-    )
+    near = np.flatnonzero(score >= top - tolerance * (top - float(score.min())))
     return int(near[np.lexsort((-score[near], change[near]))[0]])
 
 
@@ -482,6 +473,8 @@ class DwaPlanner:
         previous: Command | None = None,
         approach: bool = False,
         segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
+        route: list[tuple[float, float]] | None = None,
+        walkers: np.ndarray | None = None,
     ) -> DwaResult:
         """One control cycle from ``pose`` with current ``command`` towards the local target.
 
@@ -493,6 +486,9 @@ class DwaPlanner:
         ``approach``: the final approach, where the dist term is replaced by
         nearness to the target (goals in docks and pockets have little clearance).
         ``segment``: the global route's segment to the target, for the ``on_route`` term.
+        ``route``: the remaining global route from the AGV, along which head-on
+        ``walkers`` (rows as ``moving``: the discs that do not avoid the AGV) are
+        predicted, to get out of their way early (``planner.yielding``).
         """
         cfg = self.config
         field = self.distance_field
@@ -507,6 +503,10 @@ class DwaPlanner:
         if len(discs):
             clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
         mask = admissible_mask(cfg, commands, clearance)
+        if self.behaviour.yield_early and walkers is not None and len(walkers):
+            ends = (xs[:, -1], ys[:, -1])
+            walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+            mask = self._clear_of_walkers_later(mask, command, ends, walkers, route)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
             room = math.dist(pose[:2], target_xy)
@@ -552,12 +552,21 @@ class DwaPlanner:
         standing = math.hypot(command[0], command[1]) < _EPS
         if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
             change = jerk(commands[ok], command, command if previous is None else previous)
-            speed_change = np.hypot(commands[ok, 0], commands[ok, 1]) - math.hypot(*command[:2])
-            best = ok[steady_choice(g, change, self.behaviour.steady_tolerance, speed_change)]
+            best = ok[steady_choice(g, change, self.behaviour.steady_tolerance)]
         else:
             best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+    def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
+        """``mask`` narrowed to the samples whose end point no disc reaches before the
+        yield horizon (``planner.yielding``), when any admissible one is such."""
+        cfg = self.config
+        speed = math.hypot(command[0], command[1])
+        horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
+        later = parked_clearance(*ends, discs, route, cfg.steps * cfg.dt, horizon, cfg.radius)
+        clear = mask & (later > 0.0)
+        return clear if clear.any() else mask
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""

@@ -26,7 +26,9 @@ driven within the omega and alpha limits; every cycle in which new obstacles
 were sensed, a check of the remaining route against them and an immediate
 replan when they block it; a final approach scored by nearness to the goal;
 arrival only when stopped inside the tolerance; bounded recoveries
-(``planner/recovery.py``) and then ``failed`` with the reason.
+(``planner/recovery.py``), whose replans go round discs parked on the route,
+and then ``failed`` with the reason; a turn on the spot towards a target
+behind; early yielding to walkers (``planner/yielding.py``, in DWA).
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
 from planner.local_behaviour import local_behaviour
+from planner.parked_discs import blocking_cells
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
 from planner.route_check import blocked_point
@@ -59,6 +62,12 @@ GLOBAL_ALGORITHM = _GLOBAL_ALGORITHM
 
 CALM_WINDOWS = 3
 """Progress windows without a stall after which the recoveries start again from the first."""
+
+BEHIND = math.radians(120.0)
+"""A target this far off the body's heading is behind it: turn round on the spot first."""
+
+PARKED_ROUNDS = 3
+"""How many times a recovery replan goes round the discs parked on the plan it drew."""
 
 
 @dataclass(frozen=True)
@@ -163,7 +172,9 @@ class FusionController:
                 pose = (pose[0], pose[1], math.atan2(first[1] - pose[1], first[0] - pose[0]))
         return pose, plan
 
-    def _plan_from(self, position: Point) -> PlanResult | None:
+    def _plan_from(self, position: Point, moving: np.ndarray | None = None) -> PlanResult | None:
+        """Plan from ``position`` on what is known; with ``moving`` (default profile), round
+        the discs parked on the route too where that leaves a way."""
         if self.config.algorithm == "dwa":
             self.targets = [self.goal]
             self.target_index = 0
@@ -175,19 +186,9 @@ class FusionController:
         else:
             known = self.grid.with_blocked(self.known_cells) if self.known_cells else self.grid
             costmap = None
-        try:
-            plan = plan_global(
-                known,
-                position,
-                self.goal,
-                _GLOBAL_ALGORITHM[self.config.algorithm],
-                profile=self.config.profile,
-                clearance=self.config.clearance,
-                costmap=costmap,
-            )
-        except MapError as err:  # e.g. standing in a cell now known to be blocked
-            plan = PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
-            self.failure = str(err)
+        plan = self._search(known, costmap, position)
+        if plan.found and moving is not None and costmap is not None:
+            plan = self._round_parked(plan, position, moving)
         if not plan.found:
             parked = " and the AGVs stopped for good" if self.parked else ""
             self.failure = self.failure or f"no path to the goal on the known map{parked}"
@@ -201,6 +202,21 @@ class FusionController:
         self.targets[-1] = self.goal
         self.target_index = 0
         return plan
+
+    def _search(self, known: GridMap, costmap: Costmap | None, position: Point) -> PlanResult:
+        try:
+            return plan_global(
+                known,
+                position,
+                self.goal,
+                _GLOBAL_ALGORITHM[self.config.algorithm],
+                profile=self.config.profile,
+                clearance=self.config.clearance,
+                costmap=costmap,
+            )
+        except MapError as err:  # e.g. standing in a cell now known to be blocked
+            self.failure = str(err)
+            return PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
 
     def see(self, cells) -> bool:
         """Temporary obstacle cells inside the sensing radius; True when any is new."""
@@ -221,16 +237,19 @@ class FusionController:
         command: tuple[float, float, float],
         now: float,
         moving: np.ndarray | None = None,
+        walkers: np.ndarray | None = None,
         hold: Point | None = None,
     ) -> ControlStep:
-        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius];
-        ``hold``: wait there (the traffic rule keeps the AGV out of a passage)."""
+        """One control cycle at time ``now``; ``moving`` rows are [x, y, vx, vy, radius]:
+        every other AGV and moving obstacle; ``walkers`` those of them that do not avoid
+        the AGV (the default profile gets out of their way early); ``hold``: wait there
+        (the traffic rule keeps the AGV out of a passage)."""
         t0 = time.perf_counter()
-        out = self._step(pose, command, now, moving, hold)
+        out = self._step(pose, command, now, moving, walkers, hold)
         self._previous = command
         return replace(out, plan_time_s=time.perf_counter() - t0)
 
-    def _step(self, pose, command, now, moving, hold=None) -> ControlStep:
+    def _step(self, pose, command, now, moving, walkers, hold=None) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
         if self.status in ("arrived", "failed"):
             return _step(stop, self.status)
@@ -258,11 +277,11 @@ class FusionController:
         if hold is not None:
             return self._hold(pose, command, now, moving, hold, plan)
         if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
-            plan = self._on_stall(position, now)
+            plan = self._on_stall(position, now, moving)
             if self.status == "failed":
                 return _step(stop, self.status, plan=plan)
             if self._recovery is not None:
-                return self._step(pose, command, now, moving)
+                return self._step(pose, command, now, moving, walkers)
         self._advance_target(position)
         target = self.targets[self.target_index]
         final = self.target_index == len(self.targets) - 1
@@ -272,9 +291,14 @@ class FusionController:
             and final
             and math.dist(position, target) <= self.config.approach_distance
         )
+        turn = self._turn_round(pose, command, target, moving)
+        if turn is not None:
+            return _step(turn, "driving", target)
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
             approach=approach, segment=(self._segment_start(), target),
+            route=[position, *self.targets[self.target_index :]],
+            walkers=walkers,
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
@@ -344,6 +368,18 @@ class FusionController:
         self._best_time = now  # turning on the spot is progress for the progress checker
         return _step(cmd, "driving", first)
 
+    def _turn_round(self, pose, command, target, moving) -> tuple[float, float, float] | None:
+        """Default profile, an AGV that cannot reverse and a target behind it: the turn on
+        the spot towards it (DWA's arcs only circle, turning the body while driving on),
+        unless a walker is coming; None otherwise."""
+        if not self.behaviour.turn_round or self.config.dwa.min_vx < 0:
+            return None
+        bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
+        error = float(wrap_angle(bearing - pose[2]))
+        if abs(error) <= BEHIND or self.dwa.threatened(pose, moving):
+            return None
+        return turn_command(self.config.dwa, error, command)
+
     def _check_route(self, position: Point) -> PlanResult | None:
         """Replan at once when newly sensed obstacles block the remaining route."""
         if not self._route_stale or self.config.algorithm == "dwa":
@@ -359,8 +395,9 @@ class FusionController:
         self._best_remaining = self.remaining(position) if self.targets else math.inf
         return plan
 
-    def _on_stall(self, position: Point, now: float) -> PlanResult | None:
-        """No progress for ``progress_window``: replan (paper) or the next recovery (default)."""
+    def _on_stall(self, position: Point, now: float, moving) -> PlanResult | None:
+        """No progress for ``progress_window``: replan (paper) or the next recovery (default,
+        whose replans go round the discs parked on the route where there is a way)."""
         if not self.behaviour.recover:
             plan = self._plan_from(position)
             self._best_remaining, self._best_time = math.inf, now
@@ -375,12 +412,31 @@ class FusionController:
             return None
         kind = RECOVERIES[self._recoveries_done]
         self._recoveries_done += 1
-        plan = self._plan_from(position) if kind == "replan" else None
+        plan = self._plan_from(position, moving) if kind == "replan" else None
         if self.targets:
             self._best_remaining = self.remaining(position)
         self._best_time = now + DURATION_S[kind]
         if DURATION_S[kind] > 0:
             self._recovery = Recovery(kind, now + DURATION_S[kind])
+        return plan
+
+    def _round_parked(self, plan: PlanResult, position: Point, moving) -> PlanResult:
+        """``plan``, or a plan round the discs parked on it (and on each plan round them,
+        up to ``PARKED_ROUNDS`` times) when there is one."""
+        own = (self.grid.cell_of(position), self.grid.cell_of(self.goal))
+        marked: set[Cell] = set()
+        for _ in range(PARKED_ROUNDS):
+            route = [position, *plan.key_nodes[1:]]
+            cells = set(blocking_cells(self.grid, moving, route, self.config.dwa.radius))
+            cells -= {*own, *marked}
+            if not cells:
+                break
+            marked |= cells
+            around = self.costmap.with_blocked(marked)
+            rounded = self._search(around.grid, around, position)
+            if not rounded.found:
+                break
+            plan = rounded
         return plan
 
     def _advance_target(self, position: Point) -> None:

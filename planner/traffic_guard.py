@@ -113,9 +113,11 @@ class TrafficGuard:
             return self._decision(intent, self._hold, [rival])
         seen = next((i for i in intents if i.name == name), None)
         if seen is None or (seen.passage, seen.exit, seen.since) != (*claim, self._since):
-            if crossing.enter_at > self.stop_distance:
+            others = [i for i in intents if i.passage == crossing.passage and i.name != name]
+            if crossing.enter_at > self.stop_distance or not others:
                 return self._decision(intent)  # the fleet has not seen this claim yet
-            # asked this close (after a replan, or from the start): stop outside first
+            # asked this close while others claim it (after a replan, or from the start):
+            # stop outside first
             self._hold = self._hold or self._waiting_place(route, along + crossing.enter_at)
             return self._decision(intent, self._hold)
         allowed, blockers = may_enter(name, intents)

@@ -27,10 +27,11 @@ from fleet.scenario import (
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
 from planner.evasion import contact_times
-from planner.fusion import FusionConfig
+from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
+from planner.parked_discs import blocking_cells, covered_cells
 from planner.route_check import blocked_point
 
 DATA = Path(__file__).parent / "data"
@@ -246,3 +247,62 @@ def test_the_planner_profile_is_a_scenario_key():
     assert parse_scenario(text.format("default")).agvs[0].config.profile == "default"
     with pytest.raises(ScenarioError, match="profile"):
         parse_scenario(text.format("fast"))
+
+
+def test_a_recovery_replan_goes_round_a_disc_parked_in_the_route_where_there_is_a_way():
+    # two ways through the wall: a 1-cell gap at x = 6 (the shorter) and an open end at
+    # x = 11..13; a walker has parked in the gap. A replan that does not mark it draws the
+    # same route through it again, and the AGV fails after the recoveries.
+    grid = parse_text_grid("\n".join(["." * 14, "#" * 6 + "." + "#" * 4 + "...", "." * 14]))
+    parked = MovingObstacle("parked", 0.45, ((6.5, 1.5),), 0.0)
+    summary, states = run(
+        scenario(grid, (4.5, 0.5), (4.5, 2.5), dwa=REALISTIC, moving=[parked], time_limit=90)
+    )
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+    assert max(s.x for s in states) > 10.5  # through the open end
+
+
+def test_only_discs_at_rest_on_the_route_are_marked_for_a_replan():
+    grid = parse_text_grid("\n".join(["." * 10] * 3))
+    route = [(0.5, 1.5), (9.5, 1.5)]
+    discs = np.array(
+        [
+            [4.5, 1.5, 0.0, 0.0, 0.4],  # parked on the route: its cell
+            [7.5, 1.5, 0.5, 0.0, 0.4],  # on the route but walking
+            [2.5, 0.2, 0.0, 0.0, 0.1],  # parked 1.3 m off the route: room to pass
+        ]
+    )
+    assert blocking_cells(grid, discs, route, 0.3) == [(4, 1)]
+    assert covered_cells(grid, (5.0, 1.5), 0.4) == [(4, 1), (5, 1)]
+
+
+# a 1-cell lane with two 2-cell bays on its north side
+BAYS = parse_text_grid("\n".join(["#" * 14, "#####..###..##", "." * 14, "#" * 14]))
+
+
+@pytest.mark.parametrize(("speed", "start_at"), [(0.4, 5.0), (0.6, 10.0)])
+def test_a_walker_head_on_along_the_route_is_let_by_from_a_bay(speed, start_at):
+    # the walker walks the whole lane towards the AGV and avoids nothing; at Table 1's
+    # 0.2 m/s² the AGV must be in a bay before DWA's 3 s horizon would see the walker
+    walker = MovingObstacle("head-on", 0.35, ((0.5, 1.5), (13.5, 1.5)), speed, "once", start_at)
+    summary, states = run(scenario(BAYS, (13.5, 1.5), (0.5, 1.5), moving=[walker], time_limit=150))
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+    assert max(s.y for s in states) > 2.1  # it stood in a bay, off the walker's line
+
+
+def test_a_target_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
+    grid = parse_text_grid("\n".join(["." * 12] * 5))
+    speeds = {}
+    for profile in ("default", "paper"):
+        controller = FusionController(grid, (1.5, 2.5), FusionConfig(profile=profile))
+        controller.start((10.5, 2.5, math.pi))
+        controller.step((10.5, 2.5, math.pi), (0.0, 0.0, 0.0), 0.0)
+        command = (0.3, 0.0, 0.0)  # driving east, away from the goal
+        for k in range(3):
+            command = controller.step((9.5, 2.5, 0.0), command, 0.1 * (k + 1)).command
+        speeds[profile] = math.hypot(command[0], command[1])
+        assert command[2] < 0  # both turn (clockwise: the shorter way from 0 to pi here)
+    assert speeds["default"] == pytest.approx(0.3 - 3 * 0.02)  # braking at a_max
+    assert speeds["paper"] > 0.3  # DWA's arcs speed up, circling

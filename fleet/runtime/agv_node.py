@@ -94,7 +94,7 @@ class AgvNode:
                 plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), "traffic")
                 self.guard.replanned()
         step = self.controller.step(
-            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick),
+            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick), _walkers(tick),
             hold=decision.hold if decision else None,
         )  # fmt: skip
         if step.plan is not None:
@@ -155,8 +155,7 @@ class AgvNode:
         x, y, theta, vx, vy, omega, radius = fields.T
         velocity = world_velocity(theta, vx, vy, omega, self.scenario.dt)
         agvs = np.column_stack((x, y, velocity, radius))
-        moving = [(o.x, o.y, o.vx, o.vy, o.radius) for o in tick.moving]
-        return np.vstack((agvs, np.array(moving, dtype=float).reshape(-1, 5)))
+        return np.vstack((agvs, _walkers(tick)))
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
@@ -173,6 +172,12 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
     fleet = [a.config.clearance for a in scenario.agvs]
     widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))
     return TrafficGuard(Costmap.for_grid(scenario.grid, widest), controller.config.dwa)
+
+
+def _walkers(tick: Tick) -> np.ndarray:
+    """The moving obstacles as (x, y, vx, vy, radius) rows: discs that do not avoid an AGV."""
+    moving = [(o.x, o.y, o.vx, o.vy, o.radius) for o in tick.moving]
+    return np.array(moving, dtype=float).reshape(-1, 5)
 
 
 def plan_message(name: str, tick: Tick | None, plan: PlanResult, reason: str) -> PlanMsg:

@@ -1,0 +1,123 @@
+"""Getting out of a walker's way early (default profile).
+
+A walker does not avoid the AGV: coming head-on along the route, it walks
+into whatever stands on its line. DWA looks ``predict_time`` ahead, and by
+the time a walker is that close an AGV at Table 1's 0.2 m/s² can no longer
+brake and step aside (from 0.5 m/s: 2.5 s to stop, 3.7 s more to move 0.7 m
+sideways). So each trajectory is also judged by where it leaves the AGV: if
+it then stood at its end point, would a disc walking on reach it before the
+``yield_horizon``? DWA keeps to the trajectories that leave the AGV clear
+whenever there are any, and so steps off the walker's way while there is
+still time and room.
+
+Where a disc walks on is its ``sweep``: at its known velocity, except that a
+disc on the AGV's remaining route and walking against it is taken to follow
+the route towards the AGV (a walker keeps to the aisle it walks in; a
+straight line would leave the route at its first bend and miss the AGV).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from planner.grid_map import Point
+from planner.route_check import route_samples
+
+if TYPE_CHECKING:  # planner.dwa imports this module
+    from planner.dwa import DwaConfig
+
+YIELD_MARGIN = 2.0
+"""The time to brake and step aside, this many times over: a refuge is not always beside
+the AGV."""
+
+SWEEP_STEP = 0.1  # m: spacing of the points a sweep is checked at
+ON_ROUTE = 0.5  # m: a disc centre this near the route walks along it
+AGAINST = math.radians(45.0)  # rad: ... if it walks within this of the route's reverse
+
+
+def yield_horizon(config: DwaConfig, speed: float, disc_radius: float) -> float:
+    """Seconds ahead in which a disc must find the AGV gone from its way: the rollout, then
+    braking from ``speed`` and stepping aside by both radii from rest, within the limits."""
+    aside = config.radius + disc_radius
+    return config.predict_time + YIELD_MARGIN * (
+        speed / config.max_accel + 2.0 * math.sqrt(aside / config.max_accel)
+    )
+
+
+def arc_lengths(route: Sequence[Point]) -> np.ndarray:
+    """(P,) the distance along ``route`` to each of its points."""
+    steps = [math.dist(a, b) for a, b in itertools.pairwise(route)]
+    return np.concatenate(([0.0], np.cumsum(steps)))
+
+
+def along(route: Sequence[Point], lengths: np.ndarray, s: float) -> Point:
+    """The point at distance ``s`` along ``route`` (clamped to its ends)."""
+    s = min(max(s, 0.0), float(lengths[-1]))
+    i = min(int(np.searchsorted(lengths, s, side="right")) - 1, len(route) - 2)
+    span = lengths[i + 1] - lengths[i]
+    t = 0.0 if span <= 0 else (s - lengths[i]) / span
+    (ax, ay), (bx, by) = route[i], route[i + 1]
+    return (ax + t * (bx - ax), ay + t * (by - ay))
+
+
+def on_route_against(route: Sequence[Point], disc) -> float | None:
+    """The distance along ``route`` of a disc that walks on it towards the route's start, or
+    None (off the route, standing, or not walking against it)."""
+    x, y, vx, vy = disc[:4]
+    speed = math.hypot(vx, vy)
+    if speed <= 0 or len(route) < 2:
+        return None
+    best, best_s, direction = math.inf, 0.0, (0.0, 0.0)
+    lengths = arc_lengths(route)
+    for i, (a, b) in enumerate(itertools.pairwise(route)):
+        dx, dy = b[0] - a[0], b[1] - a[1]
+        length = math.hypot(dx, dy)
+        if length <= 0:
+            continue
+        t = min(max(((x - a[0]) * dx + (y - a[1]) * dy) / (length * length), 0.0), 1.0)
+        gap = math.hypot(x - (a[0] + t * dx), y - (a[1] + t * dy))
+        if gap < best:
+            best, best_s, direction = gap, lengths[i] + t * length, (dx / length, dy / length)
+    if best > ON_ROUTE:
+        return None
+    cos_against = -(vx * direction[0] + vy * direction[1]) / speed
+    return best_s if cos_against >= math.cos(AGAINST) else None
+
+
+def sweep(route: Sequence[Point] | None, disc, t_from: float, t_to: float) -> np.ndarray:
+    """(P, 2) points where ``disc`` [x, y, vx, vy, r] walks between ``t_from`` and ``t_to``:
+    back along ``route`` when it walks against it there, else at its velocity."""
+    x, y, vx, vy = (float(v) for v in disc[:4])
+    speed = math.hypot(vx, vy)
+    s = None if route is None else on_route_against(route, disc)
+    if s is not None:
+        lengths = arc_lengths(route)
+        ends = (s - speed * t_from, s - speed * t_to)
+        if ends[0] <= 0:  # it has passed the route's start (the AGV) by then
+            return np.array([along(route, lengths, 0.0)])
+        inner = [p for p, d in zip(route, lengths, strict=True) if ends[1] < d < ends[0]]
+        path = [along(route, lengths, ends[0]), *reversed(inner), along(route, lengths, ends[1])]
+        return route_samples(path, SWEEP_STEP)
+    start = (x + vx * t_from, y + vy * t_from)
+    end = (x + vx * t_to, y + vy * t_to)
+    return route_samples([start, end], SWEEP_STEP)
+
+
+def parked_clearance(
+    end_x: np.ndarray, end_y: np.ndarray, discs: np.ndarray, route: Sequence[Point] | None,
+    t_from: float, t_to: float, radius: float,
+) -> np.ndarray:  # fmt: skip
+    """(N,) the least clearance between an AGV standing at each end point (``end_x``,
+    ``end_y``) and the discs (M, 5) rows [x, y, vx, vy, r] walking on (``sweep``) from
+    ``t_from`` to ``t_to`` (inf: no discs)."""
+    out = np.full(len(end_x), np.inf)
+    for disc in discs:
+        points = sweep(route, disc, t_from, t_to)
+        gap = np.hypot(end_x[:, None] - points[None, :, 0], end_y[:, None] - points[None, :, 1])
+        out = np.minimum(out, gap.min(axis=1) - disc[4] - radius)
+    return out
