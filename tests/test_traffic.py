@@ -40,14 +40,17 @@ def two_rooms(corridor_cells: int) -> str:
     return "\n".join(rows)
 
 
-def passages_of(text: str, resolution: float = 0.5) -> Passages:
+WIDE = Clearance(0.4)  # an AGV 0.8 m wide: two cannot pass in 1.5 m, they can in 2 m
+
+
+def passages_of(text: str, resolution: float = 0.5, clearance: Clearance = WIDE) -> Passages:
     grid = parse_text_grid(text, resolution=resolution)
-    return Passages.build(Costmap.build(grid, Clearance()))
+    return Passages.build(Costmap.build(grid, clearance))
 
 
 # --- passages -------------------------------------------------------------------------
 def test_a_corridor_one_agv_wide_is_one_passage_with_a_mouth_at_each_end():
-    passages = passages_of(two_rooms(3))  # 1.5 m: two 0.6 m AGVs cannot pass with margins
+    passages = passages_of(two_rooms(3))  # 1.5 m: two 0.8 m AGVs cannot pass
     assert passages.count == 1
     middle = 3.75  # y of the corridor's midline
     assert passages.at((10.0, middle)) == 0
@@ -64,6 +67,7 @@ def test_a_corridor_one_agv_wide_is_one_passage_with_a_mouth_at_each_end():
 
 def test_wide_corridors_and_open_maps_have_no_passages():
     assert passages_of(two_rooms(4)).count == 0  # 2 m: two AGVs pass
+    assert passages_of(two_rooms(3), clearance=Clearance()).count == 0  # 1.5 m, 0.6 m AGVs
     room = ["#" * 18, *["#" + "." * 16 + "#"] * 16, "#" * 18]  # 4 x 4 m at 0.25 m
     assert passages_of("\n".join(room), resolution=0.25).count == 0  # corners are nooks
     for name in ("corridor", "crossing", "warehouse"):  # 2 and 3 m lanes at 1 m cells
@@ -120,8 +124,8 @@ def corridor_swap(cells: int, agvs: list[tuple[str, tuple, tuple]]) -> str:
     rows = two_rooms(cells)
     text = [
         'name = "swap"', "dt = 0.1", "time_limit = 200", "[map]", "resolution = 0.5",
-        f'grid = """\n{rows}\n"""', "[agv_defaults]", "max_speed = 1.0", "max_accel = 0.5",
-        "max_omega = 60", "max_alpha = 120",
+        f'grid = """\n{rows}\n"""', "[agv_defaults]", "radius = 0.4", "max_speed = 1.0",
+        "max_accel = 0.5", "max_omega = 60", "max_alpha = 120",
     ]  # fmt: skip
     for name, start, goal in agvs:
         heading = 180 if goal[0] < start[0] else 0
@@ -231,7 +235,7 @@ def test_a_convoy_comes_in_and_goes_out_by_the_same_mouths():
 def test_every_agv_finds_the_same_passages_whatever_its_own_radius():
     mid = 3.75
     text = corridor_swap(3, [("a", (2.0, mid), (18.0, mid)), ("b", (18.0, mid), (2.0, mid))])
-    text = text.replace('name = "b"', 'name = "b"\nradius = 0.2')
+    text = text.replace('name = "b"', 'name = "b"\nradius = 0.3')
     scenario = parse_scenario(text)
     guards = [AgvNode(scenario, name).guard for name in ("a", "b")]
     assert guards[0].passages is guards[1].passages
