@@ -4,8 +4,12 @@ Every case is a scenario written as TOML text (``TrafficCase.toml``, so a case
 can be written out and watched with ``agv-fleet run case.toml``) and parsed
 with ``fleet.scenario.parse_scenario``. Common to all cases:
 
-- map resolution 0.5 m; planner profile ``default``, algorithm ``fusion``,
-  dt 0.1 s, AGV radius 0.3 m, safety distance 0.5 m;
+- maps designed in cells of 0.5 m (``CELL``: corridor-2 is 2 cells = 1.0 m wide)
+  and drawn at 0.25 m (``RES``): with 0.5 m cells the planner's costmap has no
+  free cell in a 1.0 m passage (each cell centre is 0.25 m from a wall, less
+  than the radius), so one AGV alone fails at once with "no path to the goal";
+- planner profile ``default``, algorithm ``fusion``, dt 0.1 s, AGV radius 0.3 m,
+  safety distance 0.5 m;
 - a warehouse vehicle: max_speed 1.0 m/s, max_accel 0.5 m/s², max_omega
   60 deg/s, max_alpha 120 deg/s² (the paper's Table-1 vehicle, 0.2 m/s² and
   20 deg/s, makes every run minutes long);
