@@ -7,11 +7,12 @@ vehicle, time limits), runs each in process, and each AGV of it alone on the sam
 map (its solo run). Per case: arrivals, collisions, whether the run reached its
 time limit, the makespan (the last arrival; only when every AGV arrived) over the
 sum of the solo run times and over the longest solo run, and each AGV's waiting
-time (``waiting_time``). ``--zenoh N`` also runs the first N cases of each family
-over Zenoh (a world process and one process per AGV, as ``agv-fleet run`` does) and
-says whether the outcome (status and arrival time of every AGV, collisions, end)
-equals the in-process one. ``--write-toml DIR`` writes every case as a scenario
-file (``agv-fleet run DIR/corridor-2_n2_s0.toml`` to watch one) and exits.
+time (the run summary's: held outside a passage by the traffic rule). ``--zenoh N``
+also runs the first N cases of each family over Zenoh (a world process and one
+process per AGV, as ``agv-fleet run`` does) and says whether the outcome (status
+and arrival time of every AGV, collisions, end) equals the in-process one.
+``--write-toml DIR`` writes every case as a scenario file (``agv-fleet run
+DIR/corridor-2_n2_s0.toml`` to watch one) and exits.
 
 Prints a progress line per case on stderr, then a table per family and the
 targets (100 % arrival, 0 collisions, no run at its time limit) as PASS/MISS; a
@@ -22,7 +23,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import multiprocessing
 import os
 import statistics
@@ -36,48 +36,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.traffic_cases import FAMILIES, TrafficCase, cases, make_case  # noqa: E402
-from bridge import keys  # noqa: E402
-from bridge.messages import Tick  # noqa: E402
 from fleet.runtime.inprocess import run_in_process  # noqa: E402
 from fleet.runtime.summary import RunSummary  # noqa: E402
 from fleet.scenario import Scenario  # noqa: E402
-from planner.agv_status import FINISHED  # noqa: E402
-
-WAITING = "waiting"  # the AGV status of the traffic layer (an AGV giving way)
-STILL_SPEED = 0.02  # m/s: below it an AGV that has not finished counts as waiting
-
-
-def waiting_time(ticks: list[Tick], dt: float) -> dict[str, float]:
-    """Seconds each AGV spent waiting, from the states of every tick of a run.
-
-    An AGV waits during the period after tick k when its state at tick k has the status
-    ``waiting``. While no AGV of the run ever reports that status (today's code), an AGV
-    waits when it has neither arrived nor failed and its speed is below ``STILL_SPEED``
-    (turning in place counts as waiting). The final tick starts no period."""
-    reported = any(s.status == WAITING for t in ticks for s in t.agvs)
-    out: dict[str, float] = {}
-    for tick in ticks:
-        if tick.final:
-            continue
-        for s in tick.agvs:
-            if reported:
-                still = s.status == WAITING
-            else:
-                still = s.status not in FINISHED and math.hypot(s.vx, s.vy) < STILL_SPEED
-            out[s.name] = out.get(s.name, 0.0) + (dt if still else 0.0)
-    return {name: round(v, 6) for name, v in out.items()}
-
-
-def run_with_ticks(scenario: Scenario) -> tuple[RunSummary, list[Tick]]:
-    """Run ``scenario`` in process; its summary and every ``world/tick`` message."""
-    ticks: list[Tick] = []
-
-    def outbox(key: str, msg: object) -> None:
-        if key == keys.WORLD_TICK:
-            ticks.append(msg)
-
-    return run_in_process(scenario, outbox), ticks
-
 
 _SOLO_CACHE: dict[tuple[str, str], dict] = {}
 
@@ -88,13 +49,8 @@ def solo_run(scenario: Scenario, name: str) -> dict:
     if key not in _SOLO_CACHE:
         spec = scenario.agv(name)
         alone = replace(scenario, name=f"{scenario.name}-{name}-solo", agvs=(spec,))
-        summary, ticks = run_with_ticks(alone)
-        agv = summary.agvs[0]
-        _SOLO_CACHE[key] = {
-            "status": agv.status,
-            "time": agv.arrival_time,
-            "waiting": waiting_time(ticks, scenario.dt)[name],
-        }
+        agv = run_in_process(alone).agvs[0]
+        _SOLO_CACHE[key] = {"status": agv.status, "time": agv.arrival_time}
     return _SOLO_CACHE[key]
 
 
@@ -112,10 +68,9 @@ def run_case(family: str, seed: int) -> dict:
     """One case in process, and its solo runs: the numbers of the report."""
     case = make_case(family, seed)
     t0 = time.perf_counter()
-    summary, ticks = run_with_ticks(case.scenario)
+    summary = run_in_process(case.scenario)
     wall = time.perf_counter() - t0
-    waits = waiting_time(ticks, case.scenario.dt)
-    del ticks
+    waits = {a.name: a.waiting_time for a in summary.agvs}
     solos = {a.name: solo_run(case.scenario, a.name) for a in case.scenario.agvs}
     arrived = sum(a.status == "arrived" for a in summary.agvs)
     everyone = arrived == len(summary.agvs)
@@ -145,7 +100,6 @@ def run_case(family: str, seed: int) -> dict:
         "makespan_over_longest_solo": None if ratio_longest is None else round(ratio_longest, 4),
         "solo_failures": sorted(n for n, s in solos.items() if s["time"] is None),
         "waiting": waits,
-        "solo_waiting": {n: s["waiting"] for n, s in solos.items()},
         "statuses": {a.name: a.status for a in summary.agvs},
         "failures": {a.name: a.failure for a in summary.agvs if a.failure},
         "outcome": outcome(summary),
@@ -231,9 +185,8 @@ def print_table(rows: list[dict]) -> None:
         "arrived: AGVs arrived of all; all: runs where every AGV arrived; failed: AGVs that gave\n"
         "up; coll: runs with a collision; limit: runs that reached their time limit; mk/sum,\n"
         "mk/long: makespan (last arrival) over the sum of the solo run times and over the longest\n"
-        "solo run, runs where every AGV arrived only; wait: seconds per AGV not finished and\n"
-        "below "
-        f"{STILL_SPEED} m/s (or reporting '{WAITING}'); solo fail: AGVs that do not arrive alone."
+        "solo run, runs where every AGV arrived only; wait: seconds per AGV held outside a\n"
+        "passage by the traffic rule (status 'waiting'); solo fail: AGVs that do not arrive alone."
     )
 
 

@@ -9,12 +9,13 @@ is two-lane when one of its four half cells is at least 2 r + m/4 from every obs
 square.
 
 A *passage* cell is a cell the AGV fits in (not lethal in the costmap) from which no
-two-lane cell is within 2 r + m/4: inside a corridor, a door, an aisle end or a dock
-too narrow for two. Connected passage cells form a passage; two passages closer than
-one waiting place (``WAIT_ROOM`` times the safety distance, measured through free
-space) are one passage, so that an AGV never has to wait between two of them where
-it would block both. A passage's *mouths* are the clusters of free cells outside it
-that touch it: a corridor has two, a dock one, a crossing of corridors four.
+two-lane cell is within r + m/4 (plus half a cell). The cells beside a wall of a room
+are nearer than that to the room's two-lane middle; the cells of a corridor, a door in
+a thin wall, an aisle end or a dock too narrow for two are not. Connected passage cells
+form a passage; two passages closer than about ``WAIT_ROOM`` safety distances (through
+free space) are one, so that an AGV never has to wait between two of them where it
+would block both. A passage's *mouths* are the clusters of free cells outside it that
+touch it: a corridor has two, a dock one.
 
 Nothing is hand-marked: the map, the AGV's radius and margin decide. Built once per
 map and clearance and cached with the map, like the costmap.
@@ -89,7 +90,9 @@ class Passages:
             to_two_lane = np.sqrt(_squared_edt(two_lane)) * res
         else:
             to_two_lane = np.full(two_lane.shape, np.inf)
-        narrow = free & (to_two_lane > lane)
+        # a cell the body fits in next to a wall is within lane - r of the two-lane space
+        # beside it (plus half a cell of rounding): farther than that, it is in a passage
+        narrow = free & (to_two_lane > lane - clearance.radius + res / 2)
         join = WAIT_ROOM * clearance.safety_distance
         alone = _label_passages(narrow, free, 0)
         alone = _without_nooks(alone, _label_mouths(alone, free), clearance.safety_distance / res)

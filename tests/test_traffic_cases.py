@@ -12,7 +12,6 @@ import pytest
 
 from benchmarks import traffic_cases as tc
 from benchmarks.nav_episodes import body_path
-from benchmarks.traffic_bench import waiting_time
 from bridge.messages import AgvState, Tick
 from fleet.scenario import parse_scenario
 from planner.costmap import point_clearance
@@ -179,19 +178,6 @@ def test_fast_subset():
 def _tick(k, states, final=False):
     return Tick(k, k * 0.1, [AgvState(n, k, 0, 0, 0, vx, 0, 0, 0.3, st) for n, vx, st in states],
                 final=final)  # fmt: skip
-
-
-def test_waiting_time_counts_still_unfinished_agvs():
-    ticks = [
-        _tick(0, [("a", 0.0, "driving"), ("b", 0.5, "driving")]),
-        _tick(1, [("a", 0.01, "blocked"), ("b", 0.5, "driving")]),
-        _tick(2, [("a", 0.0, "arrived"), ("b", 0.0, "driving")]),
-        _tick(3, [("a", 0.0, "arrived"), ("b", 0.0, "driving")], final=True),
-    ]
-    assert waiting_time(ticks, 0.1) == pytest.approx({"a": 0.2, "b": 0.1})
-    # once the traffic layer reports "waiting", only that status counts
-    ticks[1].agvs[1].status = "waiting"
-    assert waiting_time(ticks, 0.1) == pytest.approx({"a": 0.0, "b": 0.1})
 
 
 def test_no_case_repeats_a_start_grid_cell_of_another_agv():
