@@ -105,8 +105,9 @@ class Tick:
     """The world's clock: tick k at time t with every AGV and obstacle.
 
     ``final`` marks the last tick of a run: the end state, which nobody answers.
-    ``intents`` are the traffic intents the AGVs sent with their commands for this
-    tick: every AGV decides on the same ones (``planner.traffic``).
+    ``intents`` are the traffic intents that claim a passage, as the AGVs sent them with
+    their commands for this tick: every AGV decides on the same ones
+    (``planner.traffic``).
     """
 
     tick: int
@@ -115,7 +116,7 @@ class Tick:
     moving: list[ObstacleState] = field(default_factory=list)
     temporary: list[list[int]] = field(default_factory=list)
     final: bool = False
-    intents: list[Intent] = field(default_factory=list)  # every running AGV's, of tick k-1
+    intents: list[Intent] = field(default_factory=list)  # passage claims, of tick k-1
 
 
 @dataclass

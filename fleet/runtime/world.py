@@ -220,8 +220,18 @@ class World:
             agvs=[AgvState(**vars(s)) for s in self.states.values()],
             moving=self.moving_obstacles(),
             temporary=[list(c) for c in self._temporary_shown],
-            intents=[self.intents[n] for n in self.states if n in self.intents],
+            intents=self._claims(),
         )
+
+    def _claims(self) -> list[Intent]:
+        """The intents that claim a passage, in the fleet's order: all the traffic rule
+        reads (the others stay in each AGV's command; every AGV decodes every tick, so a
+        tick carries no more than the rule needs)."""
+        return [
+            self.intents[n]
+            for n in self.states
+            if n in self.intents and self.intents[n].passage is not None
+        ]
 
     def moving_obstacles(self) -> list[ObstacleState]:
         out = []
