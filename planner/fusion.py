@@ -49,6 +49,7 @@ from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_glo
 from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
 from planner.local_behaviour import local_behaviour
 from planner.parked_discs import blocking_cells
+from planner.path_metrics import distance_to_path
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
 from planner.route_check import blocked_point
@@ -347,7 +348,7 @@ class FusionController:
         self.parked = cells - self.known_cells
         reach = self.config.clearance.radius
         self._parked_in_way = any(
-            self.targets and _route_distance(self._route_from_segment(), (x, y)) < radius + reach
+            self.targets and distance_to_path(self._route_from_segment(), (x, y)) < radius + reach
             for x, y, radius in discs
         )
 
@@ -460,15 +461,3 @@ class FusionController:
                 self._recoveries_done = 0
             return False
         return now - self._best_time >= self.config.progress_window
-
-
-def _route_distance(route: list[Point], point: Point) -> float:
-    """Least distance from a point to a polyline."""
-    best = math.inf
-    px, py = point
-    for (ax, ay), (bx, by) in itertools.pairwise(route):
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        t = 0.0 if length2 == 0 else min(max(((px - ax) * dx + (py - ay) * dy) / length2, 0), 1)
-        best = min(best, math.hypot(ax + t * dx - px, ay + t * dy - py))
-    return best

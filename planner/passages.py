@@ -37,6 +37,11 @@ WAIT_ROOM = 4.0
 """Passages closer than about this many safety distances (through free space, counted in
 8-connected cell steps) are one."""
 
+MAX_MOUTHS = 8
+"""A corridor has two mouths, a dock one, a crossing of corridors four to eight (its
+middle, two-lane or not, adds some); a narrow region with more is a cluttered area (a
+TurtleBot3 arena among its pillars), where there is no place to wait outside it: the
+rule leaves it to DWA."""
 NONE = -1
 """Label of a cell outside every passage / mouth."""
 _NEIGHBOURHOOD = ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (-1, -1), (1, -1), (-1, 1))
@@ -97,6 +102,10 @@ class Passages:
         alone = _label_passages(narrow, free, 0)
         alone = _without_nooks(alone, _label_mouths(alone, free), clearance.safety_distance / res)
         label = _label_passages(alone != NONE, free, max(1, math.ceil(join / (2 * res))))
+        found = cls(grid, label, _label_mouths(label, free), int(label.max()) + 1, join)
+        areas = [p for p in range(found.count) if len(found.mouths(p)) > MAX_MOUTHS]
+        if areas:  # cluttered areas, not passages: left to DWA
+            label = _renumbered(np.where(np.isin(label, areas), NONE, label).astype(np.int32))
         mouth = _label_mouths(label, free)
         for array in (label, mouth):
             array.setflags(write=False)
@@ -260,11 +269,18 @@ def _without_nooks(label: np.ndarray, mouth: np.ndarray, depth: float) -> np.nda
         gaps = np.hypot(r[:, None] - mouth_rows, c[:, None] - mouth_cols).min(axis=1)
         if gaps.max() <= depth:
             keep[r, c] = NONE
-    present = keep[keep != NONE]  # row-major
+    return _renumbered(keep)
+
+
+def _renumbered(label: np.ndarray) -> np.ndarray:
+    """Passage ids 0, 1, ... in row-major order of their first cell."""
+    present = label[label != NONE]  # row-major
+    if not len(present):
+        return label
     values, first = np.unique(present, return_index=True)
     renumber = np.full(int(label.max()) + 2, NONE, dtype=np.int32)
     renumber[values[np.argsort(first)]] = np.arange(len(values), dtype=np.int32)
-    return np.where(keep == NONE, NONE, renumber[keep]).astype(np.int32)
+    return np.where(label == NONE, NONE, renumber[label]).astype(np.int32)
 
 
 def _touches(label: np.ndarray, col: int, row: int, passage: int) -> bool:

@@ -6,6 +6,9 @@ angle sums the absolute heading changes (the paper's Tables 2 and 3).
 
 from __future__ import annotations
 
+import itertools
+import math
+
 import numpy as np
 
 # heading changes below this are numerical noise on a straight line, not turns
@@ -48,3 +51,17 @@ def total_turning_angle_deg(path) -> float:
     """Sum of absolute heading changes, degrees."""
     changes = np.abs(heading_changes_deg(path))
     return float(changes[changes > TURN_TOLERANCE_DEG].sum())
+
+
+def distance_to_path(path, point) -> float:
+    """Least distance from a point to a polyline (inf for an empty one)."""
+    best = math.inf
+    px, py = point
+    for (ax, ay), (bx, by) in itertools.pairwise(path):
+        dx, dy = bx - ax, by - ay
+        length2 = dx * dx + dy * dy
+        t = 0.0 if length2 == 0 else min(max(((px - ax) * dx + (py - ay) * dy) / length2, 0), 1)
+        best = min(best, math.hypot(ax + t * dx - px, ay + t * dy - py))
+    if len(path) == 1:
+        best = math.dist(path[0], point)
+    return best

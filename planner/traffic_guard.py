@@ -21,6 +21,7 @@ from planner.costmap import Costmap
 from planner.dwa import DwaConfig
 from planner.grid_map import Point
 from planner.passages import Crossing, Passages
+from planner.path_metrics import distance_to_path
 from planner.traffic import (
     BACK,
     CLEAR,
@@ -31,6 +32,7 @@ from planner.traffic import (
     YIELD,
     Intent,
     first_rival,
+    holders,
     may_enter,
     queue,
     stuck_holders,
@@ -125,9 +127,15 @@ class TrafficGuard:
             waited = self._phase in HELD
             intent.phase = self._phase = GO
             return self._decision(intent, rejoin=waited)
+        keep_off = [h.route for h in holders(crossing.passage, intents) if h.name != name]
+        safety = self.costmap.clearance.safety_distance
+        if self._hold is not None and any(
+            distance_to_path(r, self._hold) < 2 * safety for r in keep_off
+        ):
+            self._hold = None  # a holder's way goes through it: choose again
         if self._hold is None:
             ahead = _ahead_on_my_side(intent, intents)
-            self._hold = self._waiting_place(route, along + crossing.enter_at, ahead)
+            self._hold = self._waiting_place(route, along + crossing.enter_at, ahead, keep_off)
         if stuck_holders(crossing.passage, intents) and self._phase not in (YIELD, BACK):
             self._hold = self._further_back(route, along + crossing.enter_at)
             intent.phase = self._phase = YIELD
@@ -157,11 +165,13 @@ class TrafficGuard:
         intent.waits_for = sorted(blockers)
         return TrafficDecision(intent, hold, rejoin)
 
-    def _waiting_place(self, route: list[Point], enter_at: float, ahead: int = 0) -> Point:
+    def _waiting_place(
+        self, route: list[Point], enter_at: float, ahead: int = 0, keep_off=()
+    ) -> Point:
         """``WAIT_BACK`` before the passage (``enter_at`` m along the route), and
         ``QUEUE_GAP`` further for each of the ``ahead`` AGVs queued before it on its side
         (a crowd at the mouth blocks the AGVs coming out), moved to the right of the
-        route where free."""
+        route where free, and off the routes ``keep_off`` (the holders' routes ahead)."""
         safety = self.costmap.clearance.safety_distance
         for back in WAIT_BACK:
             back += ahead * QUEUE_GAP
@@ -169,7 +179,8 @@ class TrafficGuard:
             right = (math.sin(heading), -math.cos(heading))
             for aside in ASIDE:
                 place = (point[0] + right[0] * aside * safety, point[1] + right[1] * aside * safety)
-                if self._room_at(place) and self._room_at(_midpoint(point, place)):
+                clear = all(distance_to_path(r, place) >= 2 * safety for r in keep_off)
+                if clear and self._room_at(place) and self._room_at(_midpoint(point, place)):
                     return place
         return _point_along(route, max(0.0, enter_at - WAIT_BACK[0] * safety))[0]
 
