@@ -71,6 +71,7 @@ class TrafficGuard:
         self.release_distance = WAIT_BACK[0] * safety
         self._claim: tuple[int, int | None] | None = None
         self._entry: int | None = None
+        self._moved = False  # the waiting place was moved off a holder's way (once a claim)
         self._since = 0
         self._phase = CLEAR
         self._hold: Point | None = None
@@ -99,7 +100,7 @@ class TrafficGuard:
         claim = (crossing.passage, crossing.exit)
         if claim != self._claim:
             self._claim, self._since, self._phase, self._hold = claim, tick, REQUEST, None
-            self._entry = crossing.entry
+            self._entry, self._moved = crossing.entry, False
         intent = Intent(
             name, tick, self._phase, crossing.passage, crossing.exit, self._since,
             round(crossing.enter_at, 2), stalled, shared, entry=self._entry,
@@ -129,10 +130,12 @@ class TrafficGuard:
             return self._decision(intent, rejoin=waited)
         keep_off = [h.route for h in holders(crossing.passage, intents) if h.name != name]
         safety = self.costmap.clearance.safety_distance
-        if self._hold is not None and any(
-            distance_to_path(r, self._hold) < 2 * safety for r in keep_off
+        if (
+            self._hold is not None
+            and not self._moved
+            and any(distance_to_path(r, self._hold) < 2 * safety for r in keep_off)
         ):
-            self._hold = None  # a holder's way goes through it: choose again
+            self._hold, self._moved = None, True  # a holder's way goes through it: once
         if self._hold is None:
             ahead = _ahead_on_my_side(intent, intents)
             self._hold = self._waiting_place(route, along + crossing.enter_at, ahead, keep_off)
