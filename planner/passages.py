@@ -302,22 +302,21 @@ def _find(parent, i):
 
 
 @numba.njit(cache=True)
-def _label_passages(narrow, free, room):
-    """Passage ids: 8-connected narrow cells, joined when their components come within
-    ``room`` steps of each other through free cells (each grows ``room`` steps, so
-    components up to 2 ``room`` steps apart join); ids numbered in row-major order."""
-    height, width = narrow.shape
-    component = np.full((height, width), -1, dtype=np.int32)
+def _components(key):
+    """Ids of the 8-connected regions of cells that share a key >= 0 (-1: no region),
+    numbered in row-major order of their first cell."""
+    height, width = key.shape
+    out = np.full((height, width), -1, dtype=np.int32)
+    queue = np.empty(height * width, dtype=np.int64)
     count = 0
-    queue = np.empty(height * width * 2, dtype=np.int64)
     for r0 in range(height):
         for c0 in range(width):
-            if not narrow[r0, c0] or component[r0, c0] >= 0:
+            if key[r0, c0] < 0 or out[r0, c0] >= 0:
                 continue
             head, tail = 0, 0
             queue[tail] = r0 * width + c0
             tail += 1
-            component[r0, c0] = count
+            out[r0, c0] = count
             while head < tail:
                 r, c = divmod(queue[head], width)
                 head += 1
@@ -325,11 +324,23 @@ def _label_passages(narrow, free, room):
                     for dc in (-1, 0, 1):
                         rr, cc = r + dr, c + dc
                         inside = 0 <= rr < height and 0 <= cc < width
-                        if inside and narrow[rr, cc] and component[rr, cc] < 0:
-                            component[rr, cc] = count
+                        if inside and out[rr, cc] < 0 and key[rr, cc] == key[r0, c0]:
+                            out[rr, cc] = count
                             queue[tail] = rr * width + cc
                             tail += 1
             count += 1
+    return out
+
+
+@numba.njit(cache=True)
+def _label_passages(narrow, free, room):
+    """Passage ids: 8-connected narrow cells, joined when their components come within
+    ``room`` steps of each other through free cells (each grows ``room`` steps, so
+    components up to 2 ``room`` steps apart join); ids numbered in row-major order."""
+    height, width = narrow.shape
+    component = _components(np.where(narrow, 0, -1))
+    count = component.max() + 1
+    queue = np.empty(height * width * 2, dtype=np.int64)
     parent = np.arange(max(count, 1))
     # grow every component through free cells, at most ``room`` steps; fronts that meet
     # join their components
@@ -389,27 +400,4 @@ def _label_mouths(label, free):
                     rr, cc = r + dr, c + dc
                     if 0 <= rr < height and 0 <= cc < width and label[rr, cc] >= 0:
                         touching[r, c] = label[rr, cc]
-    mouth = np.full((height, width), -1, dtype=np.int32)
-    queue = np.empty(height * width, dtype=np.int64)
-    count = 0
-    for r0 in range(height):
-        for c0 in range(width):
-            if touching[r0, c0] < 0 or mouth[r0, c0] >= 0:
-                continue
-            head, tail = 0, 0
-            queue[tail] = r0 * width + c0
-            tail += 1
-            mouth[r0, c0] = count
-            while head < tail:
-                r, c = divmod(queue[head], width)
-                head += 1
-                for dr in (-1, 0, 1):
-                    for dc in (-1, 0, 1):
-                        rr, cc = r + dr, c + dc
-                        inside = 0 <= rr < height and 0 <= cc < width
-                        if inside and mouth[rr, cc] < 0 and touching[rr, cc] == touching[r0, c0]:
-                            mouth[rr, cc] = count
-                            queue[tail] = rr * width + cc
-                            tail += 1
-            count += 1
-    return mouth
+    return _components(touching)
