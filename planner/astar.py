@@ -65,6 +65,13 @@ class SearchResult:
 _NO_PENALTY = np.zeros((1, 1))  # the plain map's steps cost their length
 
 
+def _result(path, expansions, width: int, t0: float) -> SearchResult:
+    """The kernel's path of flat indices as (col, row) cells, timed from ``t0``."""
+    elapsed = time.perf_counter() - t0
+    cells = [(int(i % width), int(i // width)) for i in path]
+    return SearchResult(cells, int(expansions), elapsed)
+
+
 def search(
     grid: GridMap,
     start: Cell,
@@ -91,10 +98,7 @@ def search(
         corner_cutting,
         False,
     )
-    elapsed = time.perf_counter() - t0
-    width = grid.width
-    cells = [(int(i % width), int(i // width)) for i in path]
-    return SearchResult(cells, int(expansions), elapsed)
+    return _result(path, expansions, grid.width, t0)
 
 
 def search_costmap(
@@ -121,10 +125,7 @@ def search_costmap(
         False,
         True,
     )
-    elapsed = time.perf_counter() - t0
-    width = grid.width
-    cells = [(int(i % width), int(i // width)) for i in path]
-    return SearchResult(cells, int(expansions), elapsed)
+    return _result(path, expansions, grid.width, t0)
 
 
 # The open list is a binary heap of rows (f, h, node) in one (capacity, 3) array:

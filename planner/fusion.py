@@ -332,9 +332,6 @@ class FusionController:
     def route_ahead(self) -> list[Point]:
         """The rest of the route: from the start of the current segment, the targets
         still ahead."""
-        return self._route_from_segment()
-
-    def _route_from_segment(self) -> list[Point]:
         return [self._segment_start(), *self.targets[self.target_index :]]
 
     def park(self, discs) -> None:
@@ -348,7 +345,7 @@ class FusionController:
         self.parked = cells - self.known_cells
         reach = self.config.clearance.radius
         self._parked_in_way = any(
-            self.targets and distance_to_path(self._route_from_segment(), (x, y)) < radius + reach
+            self.targets and distance_to_path(self.route_ahead(), (x, y)) < radius + reach
             for x, y, radius in discs
         )
 

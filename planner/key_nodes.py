@@ -75,6 +75,25 @@ def extract_key_nodes(grid: GridMap, cells: list[Cell], safety_distance: float) 
 
 
 @numba.njit(cache=True)
+def _band_rows(c, x0, y0, x1, y1, reach, height):
+    """The rows (first, last; first > last: none) of column ``c`` that lie within
+    ``reach`` cells of segment (x0, y0)-(x1, y1), the rows beyond the border included."""
+    if x0 == x1:
+        ya = min(y0, y1)
+        yb = max(y0, y1)
+    else:
+        ta = (c - reach - x0) / (x1 - x0)
+        tb = (c + reach - x0) / (x1 - x0)
+        t_lo = max(0.0, min(ta, tb))
+        t_hi = min(1.0, max(ta, tb))
+        if t_lo > t_hi:
+            return 0, -1
+        ya = min(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
+        yb = max(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
+    return max(-1, math.floor(ya - reach)), min(height, math.ceil(yb + reach))
+
+
+@numba.njit(cache=True)
 def _point_segment_distance(px, py, x0, y0, x1, y1):
     dx = x1 - x0
     dy = y1 - y0
@@ -126,20 +145,7 @@ def segment_is_clear(blocked, x0, y0, x1, y1, safety):
     h = 0.5 + _TOUCH_EPS
     for c in range(c_lo, c_hi + 1):
         # rows the band can reach in this column
-        if x0 == x1:
-            ya = min(y0, y1)
-            yb = max(y0, y1)
-        else:
-            ta = (c - reach - x0) / (x1 - x0)
-            tb = (c + reach - x0) / (x1 - x0)
-            t_lo = max(0.0, min(ta, tb))
-            t_hi = min(1.0, max(ta, tb))
-            if t_lo > t_hi:
-                continue
-            ya = min(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
-            yb = max(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
-        r_lo = max(-1, math.floor(ya - reach))
-        r_hi = min(height, math.ceil(yb + reach))
+        r_lo, r_hi = _band_rows(c, x0, y0, x1, y1, reach, height)
         for r in range(r_lo, r_hi + 1):
             outside = c < 0 or c >= width or r < 0 or r >= height
             if not outside and not blocked[r, c]:
@@ -245,20 +251,7 @@ def segment_clearance(blocked, x0, y0, x1, y1, cap):
     c_lo = max(-1, math.floor(min(x0, x1) - reach))
     c_hi = min(width, math.ceil(max(x0, x1) + reach))
     for c in range(c_lo, c_hi + 1):
-        if x0 == x1:
-            ya = min(y0, y1)
-            yb = max(y0, y1)
-        else:
-            ta = (c - reach - x0) / (x1 - x0)
-            tb = (c + reach - x0) / (x1 - x0)
-            t_lo = max(0.0, min(ta, tb))
-            t_hi = min(1.0, max(ta, tb))
-            if t_lo > t_hi:
-                continue
-            ya = min(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
-            yb = max(y0 + t_lo * (y1 - y0), y0 + t_hi * (y1 - y0))
-        r_lo = max(-1, math.floor(ya - reach))
-        r_hi = min(height, math.ceil(yb + reach))
+        r_lo, r_hi = _band_rows(c, x0, y0, x1, y1, reach, height)
         for r in range(r_lo, r_hi + 1):
             outside = c < 0 or c >= width or r < 0 or r >= height
             if not outside and not blocked[r, c]:
