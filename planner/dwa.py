@@ -62,7 +62,7 @@ import numpy as np
 from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
-from planner.yielding import parked_clearance, yield_horizon
+from planner.yielding import YIELD_SLACK, parked_clearance, yield_horizon
 
 Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
@@ -519,7 +519,8 @@ class DwaPlanner:
                     xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius,
                     *field.origin,
                 )  # fmt: skip
-                best = evasive_index(*times)
+                speeds = np.hypot(commands[:, 0], commands[:, 1])
+                best = evasive_index(*times, speeds, cfg.max_accel, cfg.dt)
                 chosen = tuple(float(v) for v in commands[best])
                 path = (xs[best], ys[best], thetas[best])
                 return DwaResult(chosen, _poses(path), len(commands), 0)
@@ -560,13 +561,17 @@ class DwaPlanner:
 
     def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
         """``mask`` narrowed to the samples whose end point no disc reaches before the
-        yield horizon (``planner.yielding``), when any admissible one is such."""
+        yield horizon (``planner.yielding``); when no admissible one is such, to those that
+        leave the AGV furthest from the discs' way (it backs off towards a refuge rather
+        than driving on into a walker it can no longer avoid)."""
         cfg = self.config
         speed = math.hypot(command[0], command[1])
         horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
         later = parked_clearance(*ends, discs, route, cfg.steps * cfg.dt, horizon, cfg.radius)
         clear = mask & (later > 0.0)
-        return clear if clear.any() else mask
+        if clear.any() or not mask.any():
+            return clear if clear.any() else mask
+        return mask & (later >= later[mask].max() - YIELD_SLACK)
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""

@@ -2,11 +2,11 @@
 
 The paper brakes when nothing is admissible (Guo et al. 2023, section 3). A
 standing AGV is still in a walker's way, so braking is often exactly what
-gets it hit. Instead every sample of the window is ranked by its time to
-contact with the static map (later is better: a wall is certain, a
-prediction is not), then with the moving discs predicted at constant
-velocity (later is better), then by its lowest clearance over the whole
-horizon (higher is better): the AGV steps aside, backs away or brakes,
+gets it hit. Instead every sample of the window is ranked by whether it
+would meet a wall before it could brake (a wall is certain, a prediction is
+not), then by its time to contact with the moving discs predicted at
+constant velocity (later is better), then by its lowest clearance over the
+whole horizon (higher is better): the AGV steps aside, backs away or brakes,
 whichever keeps it out of contact longest without driving into a wall.
 """
 
@@ -53,6 +53,16 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0
     return static_first, moving_first, lowest
 
 
-def evasive_index(static_first: np.ndarray, moving_first: np.ndarray, lowest: np.ndarray) -> int:
-    """The sample that meets a wall last, then a moving disc last, then keeps most clearance."""
-    return int(np.lexsort((-lowest, -moving_first, -static_first))[0])
+def evasive_index(
+    static_first: np.ndarray, moving_first: np.ndarray, lowest: np.ndarray,
+    speeds: np.ndarray, max_accel: float, dt: float,
+) -> int:  # fmt: skip
+    """The sample that does not commit the AGV to a wall, then meets a moving disc last, then
+    keeps most clearance.
+
+    A wall met later than the AGV can brake for (twice its braking time, plus a cycle) is
+    no threat: the next cycle chooses again. Ranking every wall contact first would keep
+    the AGV creeping, in reach of the walker it is fleeing, wherever it has walls around.
+    """
+    committed = static_first <= 2.0 * speeds / max_accel + dt
+    return int(np.lexsort((-lowest, -moving_first, committed))[0])

@@ -24,7 +24,8 @@ trajectory (boxed in, braking) reports ``blocked``.
 The default profile (``planner/local_behaviour.py``) adds: the initial turn
 driven within the omega and alpha limits; every cycle in which new obstacles
 were sensed, a check of the remaining route against them and an immediate
-replan when they block it; a final approach scored by nearness to the goal;
+replan when they block it (and round a walker standing on the route
+nearby); a final approach scored by nearness to the goal;
 arrival only when stopped inside the tolerance; bounded recoveries
 (``planner/recovery.py``), whose replans go round discs parked on the route,
 and then ``failed`` with the reason; a turn on the spot towards a target
@@ -68,6 +69,9 @@ BEHIND = math.radians(120.0)
 """A target this far off the body's heading is behind it: turn round on the spot first."""
 
 PARKED_ROUNDS = 3
+STANDING_RANGE = 4.0
+"""m: a walker standing on the route nearer than this is gone round at once (route check):
+nearer, a walker that starts walking towards the AGV leaves it no time to step aside."""
 """How many times a recovery replan goes round the discs parked on the plan it drew."""
 
 
@@ -157,6 +161,7 @@ class FusionController:
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
+        self._rounded: set[Cell] = set()  # cells of standing walkers a replan went round
         self._parked_in_way = False  # one of them is on the route: replan
 
     # --- planning -----------------------------------------------------------------
@@ -269,7 +274,9 @@ class FusionController:
             cmd = recovery_command(kind, self.config.dwa, self.dwa.distance_field, pose, command)
             return _step(cmd, "blocked", self.targets[self.target_index])
         self._recovery = None
-        plan = self._check_route(position) if self.behaviour.route_check else None
+        plan = None
+        if self.behaviour.route_check:
+            plan = self._check_route(position) or self._round_standing(position, walkers)
         if plan is None and self._parked_in_way:  # an AGV stopped for good on the route
             self._parked_in_way = False
             plan = self.replan(position)
@@ -390,6 +397,23 @@ class FusionController:
         if blocker is None:
             return None
         plan = self._plan_from(position)  # the blocking cells are in known_cells: marked
+        self._best_remaining = self.remaining(position) if self.targets else math.inf
+        return plan
+
+    def _round_standing(self, position: Point, walkers) -> PlanResult | None:
+        """Replan at once round walkers standing on the route within ``STANDING_RANGE`` (as
+        Nav2's obstacle layer puts a standing person in the global costmap), once per
+        place they stand at; the route stays when there is no way round."""
+        if walkers is None or not len(walkers) or self.config.algorithm == "dwa":
+            return None
+        near = walkers[np.hypot(walkers[:, 0] - position[0], walkers[:, 1] - position[1])
+                       < STANDING_RANGE]  # fmt: skip
+        route = [position, *self.targets[self.target_index :]]
+        cells = set(blocking_cells(self.grid, near, route, self.config.dwa.radius))
+        if not cells - self._rounded:
+            return None
+        self._rounded |= cells
+        plan = self._plan_from(position, near)
         self._best_remaining = self.remaining(position) if self.targets else math.inf
         return plan
 

@@ -35,6 +35,10 @@ YIELD_MARGIN = 2.0
 """The time to brake and step aside, this many times over: a refuge is not always beside
 the AGV."""
 
+YIELD_SLACK = 0.1
+"""m: when no end point is clear of a walker's way, those within this of the furthest from it
+are as good (DWA's score then chooses among them)."""
+
 SWEEP_STEP = 0.1  # m: spacing of the points a sweep is checked at
 ON_ROUTE = 0.5  # m: a disc centre this near the route walks along it
 AGAINST = math.radians(45.0)  # rad: ... if it walks within this of the route's reverse

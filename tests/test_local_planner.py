@@ -26,7 +26,7 @@ from fleet.scenario import (
 )
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
-from planner.evasion import contact_times
+from planner.evasion import contact_times, evasive_index
 from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
@@ -98,6 +98,33 @@ def test_the_evasive_fallback_reads_the_map_where_it_is_in_a_shifted_map_frame()
             np.zeros((0, 5)), 0.1, 0.3, *field.origin,
         )  # fmt: skip
         assert np.isfinite(static_first[0]) and lowest[0] < 0, origin
+
+
+def test_the_evasive_fallback_flees_past_walls_it_can_still_brake_for():
+    # [creeping, hit by the walker in 0.5 s; fleeing at 0.2 m/s, at a wall in 2.9 s;
+    # fleeing at 0.5 m/s, at a wall in 0.5 s] with a_max 0.2 m/s², dt 0.1 s
+    static_first = np.array([np.inf, 2.9, 0.5])
+    moving_first = np.array([0.5, np.inf, np.inf])
+    lowest = np.array([-0.1, 0.0, -0.2])
+    speeds = np.array([0.02, 0.2, 0.5])
+    assert evasive_index(static_first, moving_first, lowest, speeds, 0.2, 0.1) == 1
+
+
+@pytest.mark.parametrize(
+    "seed",
+    [3, 42, 50],
+    ids=[
+        "realistic-walker-turning-aside-among-walls",
+        "head-on-walker-through-a-one-cell-gap",
+        "walker-standing-on-the-route-then-walking-at-the-agv",
+    ],
+)
+def test_nav_bench_episodes_that_once_ended_in_a_collision(seed):
+    from benchmarks.nav_episodes import make_episode
+
+    summary, _ = run(make_episode(seed).scenario("fusion", "default"))
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
 
 
 WALLED = "." + "#" * 3 + "." + "#" * 14 + "."  # a wall with a gap at x = 4
@@ -261,6 +288,26 @@ def test_a_recovery_replan_goes_round_a_disc_parked_in_the_route_where_there_is_
     agv = summary.agvs[0]
     assert agv.status == "arrived" and agv.collisions == 0, agv
     assert max(s.x for s in states) > 10.5  # through the open end
+
+
+def test_a_walker_standing_on_the_route_nearby_is_gone_round_at_once():
+    # the gap at x = 6 is the short way; a walker stands in it, 2.2 m from the start. The
+    # AGV replans round it in its first cycles, not after stalling in front of it (as
+    # the recovery replan above does): a walker that set off towards it from there would
+    # leave it no time to step aside
+    grid = parse_text_grid("\n".join(["." * 14, "#" * 6 + "." + "#" * 4 + "...", "." * 14]))
+    walker = MovingObstacle("walker", 0.35, ((6.5, 1.5),), 0.0)
+    sc = scenario(grid, (4.5, 0.5), (4.5, 2.5), moving=[walker], time_limit=120)
+    replans = []
+
+    def sink(key, msg):
+        if key.endswith("/plan") and msg.reason == "replan":
+            replans.append(msg.time)
+
+    summary = run_in_process(sc, sink)
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+    assert replans and replans[0] <= 0.5, replans
 
 
 def test_only_discs_at_rest_on_the_route_are_marked_for_a_replan():
