@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from planner.astar import search, search_costmap
+from planner.centring import centred
 from planner.clearance import Clearance, clearance_for
 from planner.costmap import Costmap
 from planner.grid_map import Cell, GridMap, Point
@@ -177,16 +178,20 @@ def _plan_costmap(grid, start, goal, algorithm, clearance, costmap) -> PlanResul
         [grid.to_cell_units(start), *inner, grid.to_cell_units(goal)], dtype=np.float64
     )
     res = grid.resolution
+    world = [start, *(grid.centre_of(c) for c in inner), goal]
     if algorithm == "improved":
         keep = extract_key_nodes_costmap(
             grid.blocked, points, clearance.radius / res, clearance.margin / res
         )
+        cap = (clearance.radius + clearance.margin) / res
+        key_points = centred(grid.blocked, points[keep], cap, res)
+        key_nodes = [start, *(grid.from_cell_units(p) for p in key_points[1:-1]), goal]
     else:
         keep = drop_collinear_points(points)
-    key_points = points[keep]
+        key_points = points[keep]
+        key_nodes = [world[i] for i in keep]
     elapsed = time.perf_counter() - t0
     gap = route_clearance(grid.blocked, key_points, CLEARANCE_CAP / res)
-    world = [start, *(grid.centre_of(c) for c in inner), goal]
     return PlanResult(
         algorithm,
         start,
@@ -194,7 +199,7 @@ def _plan_costmap(grid, start, goal, algorithm, clearance, costmap) -> PlanResul
         True,
         cells=result.cells,
         path=world,
-        key_nodes=[world[i] for i in keep],
+        key_nodes=key_nodes,
         expansions=result.expansions,
         time_s=elapsed,
         profile=DEFAULT,
