@@ -14,7 +14,9 @@ with ``fleet.scenario.parse_scenario``. Common to all cases:
   60 deg/s, max_alpha 120 deg/s² (the paper's Table-1 vehicle, 0.2 m/s² and
   20 deg/s, makes every run minutes long);
 - every start and goal at least radius + 0.05 m from obstacles and the map's
-  edge, starts pairwise and goals pairwise at least 1.0 m apart (1.5 m in the
+  edge and 1.5 m from every cell of a door, corridor or crossing arm
+  (``MOUTH_CLEAR``: an AGV that arrived in a doorway would close it), starts
+  pairwise and goals pairwise at least 1.0 m apart (1.5 m in the
   warehouses), and every goal reachable by the body alone (the AGV's own global
   planner finds a route);
 - time limit: 60 s + 4 x (the longest planned route / max_speed + 10 s),
@@ -63,6 +65,11 @@ RADIUS = 0.3
 SAFETY_DISTANCE = 0.5
 CLEAR = RADIUS + 0.05  # least distance of a start or goal to an obstacle or the map's edge
 MIN_SEPARATION = 1.0  # m, starts pairwise and goals pairwise
+MOUTH_CLEAR = 1.5
+"""m: least distance of a start or goal to a cell of a passage (door, corridor, arm). An
+AGV that has arrived stays where it stopped; one parked in a door's mouth closes the door
+for good, and two parked in both its mouths make a case no rule can solve (as generated
+before: door-mirror n10 s1, 7 AGVs gave up). Stations are not placed in doorways."""
 WAREHOUSE_SEPARATION = 1.5
 MAX_SPEED = 1.0
 VEHICLE = {"max_speed": MAX_SPEED, "max_accel": 0.5, "max_omega": 60, "max_alpha": 120}
@@ -114,15 +121,28 @@ def _centre(col: float, row: float) -> tuple[float, float]:
     return ((col + 0.5) * CELL, (row + 0.5) * CELL)
 
 
-def _spots(grid: GridMap, cols: range, rows: range, clear: float = CLEAR) -> list:
-    """Cell centres in the rectangle ``cols`` x ``rows`` at least ``clear`` from obstacles."""
+def _spots(grid: GridMap, cols: range, rows: range, keep_off=(), clear: float = CLEAR) -> list:
+    """Cell centres in the rectangle ``cols`` x ``rows`` at least ``clear`` from obstacles
+    and ``MOUTH_CLEAR`` from every point of ``keep_off`` (the cells of the passages)."""
+    off = np.asarray(keep_off, dtype=float).reshape(-1, 2)
     return [
         p
         for r in rows
         for c in cols
         if not grid.blocked[r, c]
         and point_clearance(grid, (p := _centre(c, r)), 2 * clear) >= clear - 1e-9
+        and (not len(off) or np.hypot(*(off - p).T).min() >= MOUTH_CLEAR)
     ]
+
+
+def _outside(grid: GridMap, rooms) -> list:
+    """The centres of the free cells outside every room (cols, rows) of ``rooms``: the
+    corridors, doors and arms between them."""
+    inside = np.zeros(grid.blocked.shape, dtype=bool)
+    for cols, rows in rooms:
+        inside[rows.start : rows.stop, cols.start : cols.stop] = True
+    rows, cols = np.nonzero(~grid.blocked & ~inside)
+    return [_centre(c, r) for r, c in zip(rows, cols, strict=True)]
 
 
 def _pick(rng, candidates: list, n: int, sep: float, taken=()) -> list:
@@ -293,8 +313,9 @@ def _two_rooms(family, seed, blocked, left_cols, right_cols, rows, n, mirror, wh
     rng = _rng(family, seed)
     grid = GridMap(blocked, CELL, family)
     width_m = blocked.shape[1] * CELL
-    left_spots = _spots(grid, left_cols, rows)
-    right_spots = _spots(grid, right_cols, rows)
+    passages = _outside(grid, [(left_cols, rows), (right_cols, rows)])
+    left_spots = _spots(grid, left_cols, rows, passages)
+    right_spots = _spots(grid, right_cols, rows, passages)
     if mirror:
         half = n // 2
         starts = _pick(rng, left_spots, half, MIN_SEPARATION)
@@ -355,7 +376,8 @@ def crossing_case(seed: int) -> TrafficCase:
     rooms = _crossing_rooms()
     order = list("WESN")
     arms = order + [order[int(i)] for i in rng.choice(4, n - 4, replace=False)]
-    spots = {k: _spots(grid, *rooms[k]) for k in order}
+    passages = _outside(grid, rooms.values())
+    spots = {k: _spots(grid, *rooms[k], passages) for k in order}
     starts = {k: _pick(rng, spots[k], arms.count(k), MIN_SEPARATION) for k in order}
     goals = {k: _pick(rng, spots[OPPOSITE[k]], arms.count(k), MIN_SEPARATION) for k in order}
     agvs = []

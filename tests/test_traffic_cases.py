@@ -185,3 +185,32 @@ def test_no_case_repeats_a_start_grid_cell_of_another_agv():
         cells = [case.scenario.grid.cell_of(a.start) for a in case.scenario.agvs]
         assert len(set(cells)) == len(cells), case.name
         assert np.isfinite(case.scenario.time_limit)
+
+
+def test_starts_and_goals_keep_out_of_the_passages_mouths():
+    # an AGV that arrived in a doorway would close it for good (see tc.MOUTH_CLEAR)
+    for case in ALL:
+        if case.family.startswith("warehouse"):
+            continue
+        grid = case.scenario.grid
+        room = ~grid.blocked
+        fine = tc.FINE
+        passages = []
+        if case.family == "crossing":
+            rooms = tc._crossing_rooms().values()
+        else:
+            width = grid.blocked.shape[1] // fine
+            rows = range(grid.blocked.shape[0] // fine)
+            left = range(0, 12 if case.family.startswith("corridor") else 20)
+            right = range(width - len(left), width)
+            rooms = [(left, rows), (right, rows)]
+        inside = np.zeros(room.shape, dtype=bool)
+        for cols, rs in rooms:
+            inside[rs.start * fine : rs.stop * fine, cols.start * fine : cols.stop * fine] = True
+        rr, cc = np.nonzero(room & ~inside)
+        passages = np.column_stack(((cc + 0.5) * grid.resolution, (rr + 0.5) * grid.resolution))
+        assert len(passages), case.name
+        for a in case.scenario.agvs:
+            for p in (a.start, a.goal):
+                gap = np.hypot(*(passages - p).T).min()
+                assert gap >= tc.MOUTH_CLEAR - tc.CELL / 2 - 1e-9, (case.name, a.name, p)
