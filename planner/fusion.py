@@ -271,7 +271,8 @@ class FusionController:
             return self._turn(pose, command, now)
         if self._recovery is not None and now < self._recovery.until - 1e-9:
             kind = self._recovery.kind
-            cmd = recovery_command(kind, self.config.dwa, self.dwa.distance_field, pose, command)
+            field = self.dwa.distance_field
+            cmd = recovery_command(kind, self.config.dwa, field, pose, command, moving)
             return _step(cmd, "blocked", self.targets[self.target_index])
         self._recovery = None
         plan = None

@@ -37,12 +37,24 @@ def towards(config: DwaConfig, command: Command, wanted: Command) -> Command:
     )
 
 
-def away_from_obstacles(field: DistanceField, pose: Pose) -> tuple[float, float]:
-    """Unit world-frame direction in which the distance to the nearest obstacle grows fastest."""
+def clearance_at(field: DistanceField, discs: np.ndarray | None, x: float, y: float) -> float:
+    """Distance from (x, y) to the nearest obstacle: the map's, or a disc's edge (rows
+    [x, y, vx, vy, r], where they stand now)."""
+    gap = float(field.distance_at(x, y))
+    if discs is not None and len(discs):
+        gap = min(gap, float((np.hypot(discs[:, 0] - x, discs[:, 1] - y) - discs[:, 4]).min()))
+    return gap
+
+
+def away_from_obstacles(
+    field: DistanceField, pose: Pose, discs: np.ndarray | None = None
+) -> tuple[float, float]:
+    """Unit world-frame direction in which the distance to the nearest obstacle (walls, and
+    the discs if given) grows fastest."""
     h = field.spacing
     x, y = pose[0], pose[1]
-    gx = field.distance_at(x + h, y) - field.distance_at(x - h, y)
-    gy = field.distance_at(x, y + h) - field.distance_at(x, y - h)
+    gx = clearance_at(field, discs, x + h, y) - clearance_at(field, discs, x - h, y)
+    gy = clearance_at(field, discs, x, y + h) - clearance_at(field, discs, x, y - h)
     norm = math.hypot(float(gx), float(gy))
     if norm < 1e-9:
         return (-math.cos(pose[2]), -math.sin(pose[2]))  # flat: straight back
@@ -50,13 +62,15 @@ def away_from_obstacles(field: DistanceField, pose: Pose) -> tuple[float, float]
 
 
 def recovery_command(
-    kind: str, config: DwaConfig, field: DistanceField, pose: Pose, command: Command
-) -> Command:
+    kind: str, config: DwaConfig, field: DistanceField, pose: Pose, command: Command,
+    discs: np.ndarray | None = None,
+) -> Command:  # fmt: skip
     """One period of the recovery ``kind``: ``wait`` brakes, ``back off`` drives slowly away
-    from the nearest obstacle (body frame, so an omnidirectional AGV needs no turn),
-    ``rotate`` turns in place at the highest rate."""
+    from the nearest obstacle, a wall or one of the ``discs`` (other AGVs, walkers; body
+    frame, so an omnidirectional AGV needs no turn), ``rotate`` turns in place at the
+    highest rate."""
     if kind == "back off":
-        ux, uy = away_from_obstacles(field, pose)
+        ux, uy = away_from_obstacles(field, pose, discs)
         c, s = math.cos(pose[2]), math.sin(pose[2])
         speed = min(BACK_OFF_SPEED, config.max_speed)
         vx, vy = speed * (ux * c + uy * s), speed * (-ux * s + uy * c)

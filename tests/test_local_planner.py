@@ -32,6 +32,7 @@ from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
 from planner.parked_discs import blocking_cells, covered_cells
+from planner.recovery import away_from_obstacles
 from planner.route_check import blocked_point
 
 DATA = Path(__file__).parent / "data"
@@ -353,3 +354,13 @@ def test_a_target_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
         assert command[2] < 0  # both turn (clockwise: the shorter way from 0 to pi here)
     assert speeds["default"] == pytest.approx(0.3 - 3 * 0.02)  # braking at a_max
     assert speeds["paper"] > 0.3  # DWA's arcs speed up, circling
+
+
+def test_backing_off_moves_away_from_a_standing_walker_not_only_from_the_walls():
+    # a wall 0.5 m south, a walker standing 0.7 m north: away from the walls alone is
+    # straight into the walker (nav_bench seed 55 backed into one in its recoveries)
+    field = DistanceField.from_grid(parse_text_grid("\n".join(["." * 10] * 5 + ["#" * 10])))
+    pose = (5.0, 1.5, 0.0)  # the wall is the bottom row (y 0..1): 0.5 m below
+    walker = np.array([[5.0, 2.2, 0.0, 0.0, 0.35]])
+    assert away_from_obstacles(field, pose)[1] > 0.9  # the walls alone: north, at the walker
+    assert away_from_obstacles(field, pose, walker)[1] < 0
