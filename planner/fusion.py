@@ -320,6 +320,9 @@ class FusionController:
         position = (pose[0], pose[1])
         if math.dist(position, hold) <= self.config.goal_tolerance:  # there: stand
             return _step(braking_command(self.config.dwa, command), WAITING, hold, plan=plan)
+        turn = self._turn_round(pose, command, hold, moving)  # behind: turn, do not circle
+        if turn is not None:
+            return _step(turn, WAITING, hold, plan=plan)
         result = self.dwa.plan(
             pose, command, hold, moving, reach=self.config.goal_tolerance, stop=True,
             previous=self._previous, approach=True, segment=(position, hold),

@@ -364,3 +364,16 @@ def test_backing_off_moves_away_from_a_standing_walker_not_only_from_the_walls()
     walker = np.array([[5.0, 2.2, 0.0, 0.0, 0.35]])
     assert away_from_obstacles(field, pose)[1] > 0.9  # the walls alone: north, at the walker
     assert away_from_obstacles(field, pose, walker)[1] < 0
+
+
+def test_a_waiting_place_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
+    # the traffic rule moved the AGV's waiting place behind it (queue, yield): driving
+    # DWA's arcs there made it circle in front of the door; like a target behind, it turns
+    grid = parse_text_grid("\n".join(["." * 12] * 5))
+    controller = FusionController(grid, (10.5, 2.5), FusionConfig())
+    controller.start((5.5, 2.5, 0.0))
+    controller.step((5.5, 2.5, 0.0), (0.0, 0.0, 0.0), 0.0)
+    out = controller.step((5.5, 2.5, 0.0), (0.3, 0.0, 0.0), 0.1, hold=(3.5, 2.5))
+    assert out.status == "waiting"
+    assert out.command[0] == pytest.approx(0.3 - DwaConfig().max_accel * DwaConfig().dt)
+    assert out.command[1] == 0.0 and out.command[2] != 0.0  # braking and turning
