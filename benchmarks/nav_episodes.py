@@ -97,9 +97,10 @@ def body_path(
     free = field.samples >= radius
     h = field.spacing
     rows, cols = free.shape
-    lattice_y, lattice_x = np.mgrid[0:rows, 0:cols] * h
-    for x, y, r in discs:
-        free &= np.hypot(lattice_x - x, lattice_y - y) >= r + radius
+    if len(discs):
+        lattice_y, lattice_x = np.mgrid[0:rows, 0:cols] * h
+        for x, y, r in discs:
+            free &= np.hypot(lattice_x - x, lattice_y - y) >= r + radius
 
     def node(p):
         return (round(p[1] / h), round(p[0] / h))

@@ -569,8 +569,10 @@ class DwaPlanner:
         horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
         later = parked_clearance(*ends, discs, route, cfg.steps * cfg.dt, horizon, cfg.radius)
         clear = mask & (later > 0.0)
-        if clear.any() or not mask.any():
-            return clear if clear.any() else mask
+        if clear.any():
+            return clear
+        if not mask.any():
+            return mask
         return mask & (later >= later[mask].max() - YIELD_SLACK)
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:

@@ -69,10 +69,11 @@ BEHIND = math.radians(120.0)
 """A target this far off the body's heading is behind it: turn round on the spot first."""
 
 PARKED_ROUNDS = 3
+"""How many times a recovery replan goes round the discs parked on the plan it drew."""
+
 STANDING_RANGE = 4.0
 """m: a walker standing on the route nearer than this is gone round at once (route check):
 nearer, a walker that starts walking towards the AGV leaves it no time to step aside."""
-"""How many times a recovery replan goes round the discs parked on the plan it drew."""
 
 
 @dataclass(frozen=True)
@@ -329,10 +330,11 @@ class FusionController:
         )  # fmt: skip
         return _step(result.command, WAITING, hold, result.trajectory, plan)
 
-    def replan(self, position: Point) -> PlanResult | None:
+    def replan(self, position: Point, moving: np.ndarray | None = None) -> PlanResult | None:
         """A new global route from ``position`` (the traffic rule moved the AGV off its
-        route); the progress measure restarts from it."""
-        plan = self._plan_from(position)
+        route, or what it senses blocks it; with ``moving``, round the discs parked on
+        it as ``_plan_from`` does); the progress measure restarts from it."""
+        plan = self._plan_from(position, moving)
         self._best_remaining = self.remaining(position) if self.targets else math.inf
         return plan
 
@@ -400,9 +402,7 @@ class FusionController:
         )
         if blocker is None:
             return None
-        plan = self._plan_from(position)  # the blocking cells are in known_cells: marked
-        self._best_remaining = self.remaining(position) if self.targets else math.inf
-        return plan
+        return self.replan(position)  # the blocking cells are in known_cells: marked
 
     def _round_standing(self, position: Point, walkers) -> PlanResult | None:
         """Replan at once round walkers standing on the route within ``STANDING_RANGE`` (as
@@ -417,9 +417,7 @@ class FusionController:
         if not cells - self._rounded:
             return None
         self._rounded |= cells
-        plan = self._plan_from(position, near)
-        self._best_remaining = self.remaining(position) if self.targets else math.inf
-        return plan
+        return self.replan(position, near)
 
     def _on_stall(self, position: Point, now: float, moving) -> PlanResult | None:
         """No progress for ``progress_window``: replan (paper) or the next recovery (default,
