@@ -575,6 +575,19 @@ class DwaPlanner:
             return mask
         return mask & (later >= later[mask].max() - YIELD_SLACK)
 
+    def clearance_along(self, path: np.ndarray, moving: np.ndarray | None) -> float:
+        """The least clearance of the (K, 3) ``path`` (poses at steps 1..K, as a rollout's)
+        to the map and to the moving discs, as a DWA sample's is computed."""
+        cfg, field = self.config, self.distance_field
+        xs, ys = np.ascontiguousarray(path[None, :, 0]), np.ascontiguousarray(path[None, :, 1])
+        clearance = static_clearance(
+            xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
+        )
+        if moving is not None and len(moving):
+            discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
+            clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
+        return float(clearance[0])
+
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""
         if moving is None or not len(moving):

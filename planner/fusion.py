@@ -54,6 +54,14 @@ from planner.path_metrics import distance_to_path
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
 from planner.route_check import blocked_point
+from planner.tight_turns import (
+    WALKER_RANGE,
+    Corner,
+    approach_command,
+    approach_path,
+    corners,
+    stopped_enough,
+)
 from planner.turning import turn_command
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
@@ -142,6 +150,7 @@ class FusionController:
         self.known_cells: set[Cell] = set()
         self.targets: list[Point] = []
         self.target_index = 0
+        self.corners: list[Corner] = []  # how each target but the goal is passed
         self.status = "driving"
         self.failure = ""
         self.behaviour = local_behaviour(self.config.profile, free_heading=self.config.free_heading)
@@ -208,7 +217,17 @@ class FusionController:
         self.targets = list(plan.key_nodes[1:]) or [self.goal]
         self.targets[-1] = self.goal
         self.target_index = 0
+        self.corners = self._corners_of(position)
         return plan
+
+    def _corners_of(self, position: Point) -> list[Corner]:
+        """Each target's switch reach: the paper's ``switch_distance``, or (default profile)
+        less where switching early would cut into a narrow stretch (``planner.tight_turns``)."""
+        reach = self.config.switch_distance
+        if not self.behaviour.tight_turns:
+            return [Corner(reach, False)] * (len(self.targets) - 1)
+        radius = self.config.dwa.radius
+        return corners(self.dwa.distance_field, radius, position, self.targets, reach)
 
     def _search(self, known: GridMap, costmap: Costmap | None, position: Point) -> PlanResult:
         try:
@@ -292,10 +311,11 @@ class FusionController:
                 return _step(stop, self.status, plan=plan)
             if self._recovery is not None:
                 return self._step(pose, command, now, moving, walkers)
-        self._advance_target(position)
+        straight = self._advance_target(pose, command, moving, walkers)
+        if self._turning:  # stopped at a tight corner: face the next stretch first
+            return self._turn(pose, command, now)
         target = self.targets[self.target_index]
         final = self.target_index == len(self.targets) - 1
-        reach = self.config.goal_tolerance if final else self.config.switch_distance
         approach = (
             self.behaviour.final_approach
             and final
@@ -304,6 +324,9 @@ class FusionController:
         turn = self._turn_round(pose, command, target, moving)
         if turn is not None:
             return _step(turn, "driving", target)
+        if straight is not None:  # the last metres to a tight corner, straight
+            return _step(straight[0], "driving", target, straight[1], plan)
+        reach = self.config.goal_tolerance if final else self._dwa_reach()
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
             approach=approach, segment=(self._segment_start(), target),
@@ -368,8 +391,9 @@ class FusionController:
         return self.targets[self.target_index - 1] if self.target_index else self._planned_at
 
     def _turn(self, pose, command, now) -> ControlStep:
-        """The initial turn towards the first key node, as motion within the limits."""
-        first = self.targets[0]
+        """The turn on the spot towards the current target (the first key node at the start,
+        the next stretch at a tight corner), as motion within the limits."""
+        first = self.targets[self.target_index]
         bearing = math.atan2(first[1] - pose[1], first[0] - pose[0])
         error = float(wrap_angle(bearing - pose[2]))
         cmd = turn_command(self.config.dwa, error, command)
@@ -390,6 +414,29 @@ class FusionController:
         if abs(error) <= BEHIND or self.dwa.threatened(pose, moving):
             return None
         return turn_command(self.config.dwa, error, command)
+
+    def _straight_to(self, pose, command, node: Point, moving, walkers):
+        """The command and predicted path of the straight approach to a tight corner, when
+        within ``approach_distance``, no walker is within ``WALKER_RANGE`` and, driven no
+        faster than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps
+        clear of the map and the moving discs over the horizon; None: DWA drives (and avoids)."""
+        if math.dist(pose[:2], node) > self.config.approach_distance:
+            return None
+        if walkers is not None and len(walkers):
+            near = np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE
+            if near.any():
+                return None
+        cfg = self.config.dwa
+        room = self.dwa.clearance_along(
+            approach_path(cfg, pose, command, node, cfg.max_speed), moving
+        )
+        if room <= 0.0:
+            return None
+        cap = math.sqrt(2.0 * room * cfg.max_accel)  # the approach keeps below Eq. (7)'s limit
+        path = approach_path(cfg, pose, command, node, cap)
+        if self.dwa.clearance_along(path, moving) <= 0.0:
+            return None
+        return approach_command(cfg, pose, command, node, cap), path
 
     def _check_route(self, position: Point) -> PlanResult | None:
         """Replan at once when newly sensed obstacles block the remaining route."""
@@ -463,13 +510,37 @@ class FusionController:
             plan = rounded
         return plan
 
-    def _advance_target(self, position: Point) -> None:
+    def _advance_target(self, pose, command, moving, walkers):
+        """Switch to the next target within the current one's reach. A tight corner that
+        the straight approach can drive to is switched from only once stopped there, and
+        then turned on the spot towards the next; returns that approach's (command, path)
+        for the current target, None when DWA drives (then a tight corner whose approach is
+        not clear, e.g. with a walker near, is passed like any key node)."""
         last = len(self.targets) - 1
-        while (
-            self.target_index < last
-            and math.dist(position, self.targets[self.target_index]) <= self.config.switch_distance
-        ):
+        while self.target_index < last:
+            corner = self.corners[self.target_index]
+            node = self.targets[self.target_index]
+            distance = math.dist(pose[:2], node)
+            straight = None
+            if corner.stop:
+                straight = self._straight_to(pose, command, node, moving, walkers)
+            if straight is None:
+                if distance > self._dwa_reach():
+                    return None
+            elif distance > corner.reach or not stopped_enough(self.config.dwa, command):
+                return straight  # not there, or not stopped yet
             self.target_index += 1
+            if straight is not None:
+                self._turning = True  # turn_command brakes omega, then turns
+                return None
+        return None
+
+    def _dwa_reach(self) -> float:
+        """How near DWA must come to the current key node to switch to the next: the
+        corner's reach, or the paper's ``switch_distance`` at a stop corner (DWA cannot
+        stop on a point: near one its near-best samples spiral round it)."""
+        corner = self.corners[self.target_index]
+        return self.config.switch_distance if corner.stop else corner.reach
 
     def remaining(self, position: Point) -> float:
         """Route length left: to the current target, then along the remaining targets."""

@@ -1,0 +1,112 @@
+"""Where the route turns into a 1.0 m corridor, the AGV does not cut the corner: it
+switches late, or stops at the node and turns on the spot (``planner.tight_turns``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from benchmarks import traffic_cases as tc
+from bridge import keys
+from fleet.runtime.inprocess import run_in_process
+from planner.distance_field import DistanceField
+from planner.dwa import DwaConfig, step_pose
+from planner.fusion import FusionConfig, FusionController
+from planner.grid_map import GridMap
+from planner.map_io import parse_text_grid
+from planner.tight_turns import (
+    MIN_REACH,
+    TURN_ON_SPOT,
+    approach_command,
+    approach_path,
+    corner,
+    room_ahead,
+    turn_angle,
+)
+
+RADIUS = 0.3
+
+
+def _corridor_field() -> DistanceField:
+    """Two rooms joined by a 1.0 m corridor along y = 4.0 m from x = 6 m to x = 18 m."""
+    return DistanceField.from_grid(GridMap(tc.fine_map(tc.corridor_map(2, 24)), tc.RES, "c2"))
+
+
+def test_a_sharp_turn_into_a_one_metre_corridor_is_a_stop_and_a_turn():
+    field = _corridor_field()
+    mouth = corner(field, RADIUS, (5.25, 6.25), (5.5, 4.0), (16.8, 4.0), 1.0)
+    assert mouth.stop
+    assert MIN_REACH <= mouth.reach <= 0.21  # 0.2 m to spare beside the body, / sin(84°)
+
+
+def test_a_straight_run_into_a_corridor_and_a_turn_in_the_open_keep_the_paper_switch():
+    field = _corridor_field()
+    straight = corner(field, RADIUS, (2.0, 4.0), (5.5, 4.0), (16.8, 4.0), 1.0)
+    assert straight.reach == 1.0 and not straight.stop
+    open_room = DistanceField.from_grid(parse_text_grid("\n".join(["." * 20] * 20)))
+    assert corner(open_room, RADIUS, (5.0, 5.0), (10.0, 5.0), (10.0, 15.0), 1.0).reach == 1.0
+
+
+def test_a_slight_bend_into_a_corridor_is_passed_without_stopping():
+    field = _corridor_field()
+    bend = corner(field, RADIUS, (2.0, 4.4), (5.5, 4.0), (16.8, 4.0), 1.0)
+    assert turn_angle((2.0, 4.4), (5.5, 4.0), (16.8, 4.0)) < TURN_ON_SPOT
+    assert not bend.stop
+    # switching 1 m early cuts this bend by ~0.11 m: within the body's 0.2 m of room
+    assert bend.reach == 1.0
+
+
+def test_the_switch_reach_bounds_the_corner_cut_by_the_room():
+    field = _corridor_field()
+    for before in [(2.0, 5.5), (3.0, 6.0), (5.0, 7.0), (5.5, 8.0)]:
+        c = corner(field, RADIUS, before, (5.5, 4.0), (16.8, 4.0), 1.0)
+        phi = turn_angle(before, (5.5, 4.0), (16.8, 4.0))
+        room = room_ahead(field, RADIUS, (5.5, 4.0), (16.8, 4.0))
+        assert c.reach * math.sin(min(phi, math.pi / 2)) <= room + 1e-9, before
+        assert c.stop == (phi > TURN_ON_SPOT), before
+
+
+def test_the_straight_approach_ends_at_rest_on_the_node_within_the_limits():
+    config = DwaConfig(max_speed=1.0, max_accel=0.5)
+    pose, command, node = (0.0, 0.0, 0.3), (0.2, -0.1, 0.1), (2.0, 0.5)
+    for _ in range(200):
+        new = approach_command(config, pose, command, node, config.max_speed)
+        for axis in range(2):
+            assert abs(new[axis] - command[axis]) <= config.max_accel * config.dt + 1e-9
+        assert math.hypot(new[0], new[1]) <= config.max_speed + 1e-9
+        command, pose = new, step_pose(pose, new, config.dt)
+    assert math.dist(pose[:2], node) < 0.05
+    assert math.hypot(command[0], command[1]) < 1e-6
+    assert approach_path(config, pose, command, node, config.max_speed).shape == (config.steps, 3)
+
+
+def test_an_agv_alone_turns_into_a_one_metre_corridor_and_arrives():
+    # traffic suite corridor-2 seed 3, AGV L3 alone: it used to cut the corner at the mouth,
+    # end up beside it and slide along the wall until it failed after its recoveries
+    case = tc.make_case("corridor-2", 3).scenario
+    scenario = replace(case, agvs=(case.agv("L3"),))
+    headings = []
+
+    def sink(key, msg):
+        if key == keys.WORLD_TICK:
+            headings.extend(a.theta for a in msg.agvs if 7.0 <= a.x <= 16.0)
+
+    summary = run_in_process(scenario, sink)
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv.failure
+    assert agv.arrival_time < 60.0  # 13 m of corridor at 0.42 m/s, and the rooms
+    # inside the corridor the body faces along it
+    assert max(abs(math.remainder(h, math.tau)) for h in headings) < math.radians(10)
+
+
+def test_only_the_default_profile_stops_at_tight_corners():
+    grid = GridMap(tc.fine_map(tc.corridor_map(2, 24)), tc.RES, "c2")
+    stops = {}
+    for profile in ("default", "paper"):
+        config = FusionConfig(profile=profile, dwa=DwaConfig(radius=RADIUS), safety_distance=0.5)
+        controller = FusionController(grid, (18.25, 6.75), config)
+        controller.start((5.25, 6.25, 0.0))
+        stops[profile] = [c.stop for c in controller.corners]
+        if profile == "paper":
+            assert all(c.reach == config.switch_distance for c in controller.corners)
+    assert any(stops["default"]) and not any(stops["paper"])
