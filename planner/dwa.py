@@ -499,7 +499,8 @@ class DwaPlanner:
         clearance = static_clearance(
             xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
         )
-        discs = relevant_discs(cfg, pose, xs, ys, discs, float(clearance.max()))
+        static_best = float(clearance.max())
+        discs = relevant_discs(cfg, pose, xs, ys, discs, static_best)
         if len(discs):
             clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
         mask = admissible_mask(cfg, commands, clearance)
@@ -514,7 +515,7 @@ class DwaPlanner:
             mask &= speed <= limit + _EPS
         ok = np.flatnonzero(mask)
         if ok.size == 0:
-            if self.behaviour.evade:
+            if self.behaviour.evade and self._evade_from(pose, xs, ys, discs, walkers, static_best):
                 times = contact_times(
                     xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius,
                     *field.origin,
@@ -587,6 +588,18 @@ class DwaPlanner:
             discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
             clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
         return float(clearance[0])
+
+    def _evade_from(self, pose, xs, ys, discs, walkers, bound: float) -> bool:
+        """Whether the evasive fallback applies: against walls and walkers, not when the only
+        moving discs in reach are AGVs. They plan too; an AGV that brakes is predictable to
+        them, one that flees at full speed into a crowded aisle is not (the stress suite's
+        warehouse-40 collisions were between two AGVs, one of them fleeing)."""
+        if not len(discs):
+            return True
+        if walkers is None or not len(walkers):
+            return False
+        walkers = np.ascontiguousarray(np.asarray(walkers, dtype=float).reshape(-1, 5))
+        return len(relevant_discs(self.config, pose, xs, ys, walkers, bound)) > 0
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""

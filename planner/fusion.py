@@ -79,6 +79,12 @@ BEHIND = math.radians(120.0)
 PARKED_ROUNDS = 3
 """How many times a recovery replan goes round the discs parked on the plan it drew."""
 
+JAM_RANGE = 2.0
+"""m: a stalled AGV with another AGV this near (centre to centre) is in a jam, not at a
+dead end: when its recoveries run out it starts them again (``JAM_RESTARTS`` times)."""
+
+JAM_RESTARTS = 2
+
 STANDING_RANGE = 4.0
 """m: a walker standing on the route nearer than this is gone round at once (route check):
 nearer, a walker that starts walking towards the AGV leaves it no time to step aside."""
@@ -167,6 +173,7 @@ class FusionController:
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
         self._recoveries_done = 0
+        self._jam_restarts = 0  # recovery sequences started again in a jam
         self._last_stall = -math.inf  # sim time of the last stall
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
@@ -306,7 +313,7 @@ class FusionController:
         if hold is not None:
             return self._hold(pose, command, now, moving, hold, plan)
         if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
-            plan = self._on_stall(position, now, moving)
+            plan = self._on_stall(position, now, moving, walkers)
             if self.status == "failed":
                 return _step(stop, self.status, plan=plan)
             if self._recovery is not None:
@@ -466,15 +473,20 @@ class FusionController:
         self._rounded |= cells
         return self.replan(position, near)
 
-    def _on_stall(self, position: Point, now: float, moving) -> PlanResult | None:
+    def _on_stall(self, position: Point, now: float, moving, walkers) -> PlanResult | None:
         """No progress for ``progress_window``: replan (paper) or the next recovery (default,
-        whose replans go round the discs parked on the route where there is a way)."""
+        whose replans go round the discs parked on the route where there is a way; in a jam
+        of AGVs the sequence starts again, ``JAM_RESTARTS`` times, before it fails)."""
         if not self.behaviour.recover:
             plan = self._plan_from(position)
             self._best_remaining, self._best_time = math.inf, now
             return plan
         self._last_stall = now
-        if self._recoveries_done >= len(RECOVERIES):
+        exhausted = self._recoveries_done >= len(RECOVERIES)
+        if exhausted and self._jam_restarts < JAM_RESTARTS and _agv_near(position, moving, walkers):
+            self._jam_restarts += 1
+            self._recoveries_done = 0
+        elif exhausted:
             self.status = "failed"
             self.failure = (
                 f"no progress after the recoveries {', '.join(RECOVERIES)} "
@@ -552,6 +564,19 @@ class FusionController:
         if remaining < self._best_remaining - self.config.progress_distance:
             self._best_remaining, self._best_time = remaining, now
             if now - self._last_stall >= CALM_WINDOWS * self.config.progress_window:
-                self._recoveries_done = 0
+                self._recoveries_done = self._jam_restarts = 0
             return False
         return now - self._best_time >= self.config.progress_window
+
+
+def _agv_near(position: Point, moving, walkers) -> bool:
+    """Whether another AGV is within ``JAM_RANGE``: a moving disc that is not a walker (the
+    walkers are rows of ``moving`` too)."""
+
+    def near(discs) -> int:
+        if discs is None or not len(discs):
+            return 0
+        gap = np.hypot(discs[:, 0] - position[0], discs[:, 1] - position[1])
+        return int((gap < JAM_RANGE).sum())
+
+    return near(moving) > near(walkers)

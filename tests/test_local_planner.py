@@ -77,11 +77,23 @@ def test_evasive_fallback_steps_out_of_a_walkers_way_where_the_paper_brakes():
     pose, still = (6.0, 6.0, 0.0), (0.0, 0.0, 0.0)
     paper = DwaPlanner(DwaConfig(), field).plan(pose, still, (6.0, 10.0), walker)
     default = DwaPlanner(DwaConfig(), field, local_behaviour("default"))
-    evade = default.plan(pose, still, (6.0, 10.0), walker)
+    evade = default.plan(pose, still, (6.0, 10.0), walker, walkers=walker)
     assert not paper.admissible and paper.command == still
     assert not evade.admissible and evade.command != still
     # the walker's predicted path is x = 6: the evasive step moves away from it
     assert abs(evade.trajectory[-1, 0] - 6.0) > 0.05
+
+
+def test_the_evasive_fallback_brakes_when_only_agvs_come():
+    # another AGV plans too: an AGV that brakes is predictable to it, one that flees at
+    # full speed into a crowded aisle is not (traffic suite warehouse-40: two AGVs
+    # collided, one of them fleeing a third)
+    field = DistanceField.from_grid(parse_text_grid("\n".join(["." * 12] * 12)))
+    agv = np.array([[6.0, 8.0, 0.0, -1.0, 0.4]])
+    default = DwaPlanner(DwaConfig(), field, local_behaviour("default"))
+    still = (0.0, 0.0, 0.0)
+    out = default.plan((6.0, 6.0, 0.0), still, (6.0, 10.0), agv, walkers=np.zeros((0, 5)))
+    assert not out.admissible and out.command == still
 
 
 def test_the_evasive_fallback_reads_the_map_where_it_is_in_a_shifted_map_frame():
@@ -377,3 +389,25 @@ def test_a_waiting_place_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_s
     assert out.status == "waiting"
     assert out.command[0] == pytest.approx(0.3 - DwaConfig().max_accel * DwaConfig().dt)
     assert out.command[1] == 0.0 and out.command[2] != 0.0  # braking and turning
+
+
+def _fails_at(moving: np.ndarray, walkers: np.ndarray) -> float:
+    """When a controller held in place (its commands never move it) on an open floor gives
+    up, with ``moving`` standing 1 m beside it."""
+    grid = parse_text_grid("\n".join(["." * 12] * 12))
+    controller = FusionController(grid, (10.5, 6.0), FusionConfig())
+    pose = (2.0, 6.0, 0.0)
+    controller.start(pose)
+    for k in range(6000):
+        out = controller.step(pose, (0.0, 0.0, 0.0), 0.1 * k, moving, walkers)
+        if out.status == "failed":
+            return 0.1 * k
+    return math.inf
+
+
+def test_a_stall_among_agvs_is_a_jam_and_the_recoveries_start_again_before_failing():
+    disc = np.array([[2.0, 7.0, 0.0, 0.0, 0.3]])  # beside the AGV, off its way
+    alone = _fails_at(disc, disc)  # a standing walker: not a jam
+    jam = _fails_at(disc, np.zeros((0, 5)))  # another AGV
+    assert alone < math.inf and jam < math.inf  # bounded either way
+    assert jam > 2.5 * alone  # the sequence ran three times
