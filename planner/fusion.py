@@ -55,7 +55,6 @@ from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
 from planner.route_check import blocked_point
 from planner.tight_turns import (
-    WALKER_RANGE,
     Corner,
     approach_command,
     approach_path,
@@ -63,6 +62,7 @@ from planner.tight_turns import (
     stopped_enough,
 )
 from planner.turning import turn_command
+from planner.yielding import walker_near
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
@@ -80,8 +80,9 @@ PARKED_ROUNDS = 3
 """How many times a recovery replan goes round the discs parked on the plan it drew."""
 
 JAM_RANGE = 2.0
-"""m: a stalled AGV with another AGV this near (centre to centre) is in a jam, not at a
-dead end: when its recoveries run out it starts them again (``JAM_RESTARTS`` times)."""
+"""m: an AGV that had another AGV this near (centre to centre) at one of the stalls of its
+recovery sequence is in a jam, not at a dead end: when the sequence runs out it starts
+again (``JAM_RESTARTS`` times)."""
 
 JAM_RESTARTS = 2
 
@@ -174,6 +175,7 @@ class FusionController:
         self._recovery: Recovery | None = None
         self._recoveries_done = 0
         self._jam_restarts = 0  # recovery sequences started again in a jam
+        self._jammed = False  # another AGV was near at a stall of this sequence
         self._last_stall = -math.inf  # sim time of the last stall
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
@@ -424,15 +426,13 @@ class FusionController:
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
         """The command and predicted path of the straight approach to a tight corner, when
-        within ``approach_distance``, no walker is within ``WALKER_RANGE`` and, driven no
+        within ``approach_distance``, no walker is near (``walker_near``) and, driven no
         faster than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps
         clear of the map and the moving discs over the horizon; None: DWA drives (and avoids)."""
         if math.dist(pose[:2], node) > self.config.approach_distance:
             return None
-        if walkers is not None and len(walkers):
-            near = np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE
-            if near.any():
-                return None
+        if walker_near(pose, walkers):
+            return None
         cfg = self.config.dwa
         room = self.dwa.clearance_along(
             approach_path(cfg, pose, command, node, cfg.max_speed), moving
@@ -482,10 +482,11 @@ class FusionController:
             self._best_remaining, self._best_time = math.inf, now
             return plan
         self._last_stall = now
+        self._jammed = self._jammed or _agv_near(position, moving, walkers)
         exhausted = self._recoveries_done >= len(RECOVERIES)
-        if exhausted and self._jam_restarts < JAM_RESTARTS and _agv_near(position, moving, walkers):
+        if exhausted and self._jammed and self._jam_restarts < JAM_RESTARTS:
             self._jam_restarts += 1
-            self._recoveries_done = 0
+            self._recoveries_done, self._jammed = 0, False
         elif exhausted:
             self.status = "failed"
             self.failure = (
@@ -565,6 +566,7 @@ class FusionController:
             self._best_remaining, self._best_time = remaining, now
             if now - self._last_stall >= CALM_WINDOWS * self.config.progress_window:
                 self._recoveries_done = self._jam_restarts = 0
+                self._jammed = False
             return False
         return now - self._best_time >= self.config.progress_window
 

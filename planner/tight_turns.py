@@ -38,9 +38,6 @@ TURN_ON_SPOT = math.radians(10.0)
 LOOK_AHEAD = 2.0
 """m: how much of the next stretch counts for the room the body has where it enters."""
 
-WALKER_RANGE = 4.0
-"""m: with a walker this near the approach is left to DWA, which yields to walkers early."""
-
 FACE_FROM = 0.5
 """m: the straight approach turns the body towards the node until this near it."""
 

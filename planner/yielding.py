@@ -125,3 +125,18 @@ def parked_clearance(
         gap = np.hypot(end_x[:, None] - points[None, :, 0], end_y[:, None] - points[None, :, 1])
         out = np.minimum(out, gap.min(axis=1) - disc[4] - radius)
     return out
+
+
+WALKER_RANGE = 12.0
+"""m: with a walker this near, the AGV leaves the room to yield: no straight approach to a
+tight corner (``planner.tight_turns``), no speeding up out of a steady choice (DWA). A
+walker at 1 m/s and an AGV at 2 m/s close 12 m in 4 s, about the yield horizon at
+Table 1's limits (nav_bench: 4, 6, 8 m left 2, 2, 1 collisions; 12 m, 1)."""
+
+
+def walker_near(pose, walkers) -> bool:
+    """Whether a walker (rows [x, y, vx, vy, r]) is within ``WALKER_RANGE`` of ``pose``."""
+    if walkers is None or not len(walkers):
+        return False
+    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+    return bool((np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE).any())
