@@ -313,7 +313,7 @@ class FusionController:
         if self.status == "failed":
             return _step(stop, self.status, plan=plan)
         if hold is not None:
-            return self._hold(pose, command, now, moving, hold, plan)
+            return self._hold(pose, command, now, moving, walkers, hold, plan)
         if plan is None and self._stalled(position, now) and self.config.algorithm != "dwa":
             plan = self._on_stall(position, now, moving, walkers)
             if self.status == "failed":
@@ -345,8 +345,10 @@ class FusionController:
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
 
-    def _hold(self, pose, command, now, moving, hold: Point, plan) -> ControlStep:
-        """Drive to ``hold`` and wait there; waiting is not a stall (no recoveries)."""
+    def _hold(self, pose, command, now, moving, walkers, hold: Point, plan) -> ControlStep:
+        """Drive to ``hold`` and wait there; waiting is not a stall (no recoveries). The last
+        metres are driven straight where that is clear, as to a tight corner: DWA's arcs
+        circled in front of the door while the waiting place moved."""
         self._best_time = now
         self._best_remaining = min(self._best_remaining, self.remaining(pose[:2]))
         self.status = WAITING
@@ -356,6 +358,9 @@ class FusionController:
         turn = self._turn_round(pose, command, hold, moving)  # behind: turn, do not circle
         if turn is not None:
             return _step(turn, WAITING, hold, plan=plan)
+        straight = self._straight_to(pose, command, hold, moving, walkers)
+        if straight is not None:
+            return _step(straight[0], WAITING, hold, straight[1], plan)
         result = self.dwa.plan(
             pose, command, hold, moving, reach=self.config.goal_tolerance, stop=True,
             previous=self._previous, approach=True, segment=(position, hold),

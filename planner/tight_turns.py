@@ -41,6 +41,10 @@ LOOK_AHEAD = 2.0
 FACE_FROM = 0.5
 """m: the straight approach turns the body towards the node until this near it."""
 
+FACE_FIRST = math.radians(15.0)
+"""rad: a node this far off the heading is faced first, turning on the spot (turning while
+driving bends the way: the body-frame velocity turns with the body)."""
+
 MIN_REACH = 0.1
 """m: the least switch reach (the AGV must be able to get this near a node)."""
 
@@ -121,11 +125,13 @@ def approach_command(
     config: DwaConfig, pose: Pose, command: Command, node: Point, cap: float
 ) -> Command:
     """The next command driving straight to ``node`` and stopping there: the speed follows
-    the braking curve sqrt(2 a d), at most ``cap`` and d / dt; each axis changes by at most
-    a period of acceleration (an omnidirectional body slides sideways for what is off its
-    heading; vx stays within ``min_vx``). Farther than ``FACE_FROM`` the body turns to face
-    the node (on the curve sqrt(2 alpha |error|), as ``turn_command``); nearer, the turn
-    rate brakes to zero (the turn on the spot follows)."""
+    the braking curve sqrt(2 a d), at most ``cap`` and d / dt; the velocity changes by at
+    most a period of acceleration per axis, scaled as a whole so that its direction holds
+    (an omnidirectional body slides sideways for what is off its heading; vx stays within
+    ``min_vx``). Farther than ``FACE_FROM`` the body turns to face
+    the node (on the curve sqrt(2 alpha |error|), as ``turn_command``), on the spot first
+    when it is more than ``FACE_FIRST`` off; nearer, the turn rate brakes to zero (the
+    turn on the spot at the node follows)."""
     dx, dy = node[0] - pose[0], node[1] - pose[1]
     distance = math.hypot(dx, dy)
     if distance < 1e-9:
@@ -141,7 +147,19 @@ def approach_command(
     omega = 0.0
     if distance > FACE_FROM:
         error = math.remainder(math.atan2(dy, dx) - pose[2], math.tau)
-        omega = math.copysign(
-            min(config.max_omega, math.sqrt(2.0 * config.max_alpha * abs(error))), error
-        )
-    return towards(config, command, (max(vx, config.min_vx), vy, omega))
+        if abs(error) > FACE_FIRST:  # face the node first: brake and turn on the spot
+            vx = vy = 0.0
+        # turning the body turns a body-frame velocity with it: no faster than half a period
+        # of acceleration can make up for, so that the way stays straight
+        moving = math.hypot(command[0], command[1])
+        fastest = min(config.max_omega, config.max_accel / (2.0 * moving) if moving else math.inf)
+        omega = math.copysign(min(fastest, math.sqrt(2.0 * config.max_alpha * abs(error))), error)
+    # the linear change scaled as a whole (not clipped per axis), so that the velocity turns
+    # towards the node's direction along a straight line instead of bending round it
+    dvx, dvy = max(vx, config.min_vx) - command[0], vy - command[1]
+    dv = config.max_accel * config.dt
+    scale = max(abs(dvx), abs(dvy)) / dv
+    if scale > 1.0:
+        dvx, dvy = dvx / scale, dvy / scale
+    turn = towards(config, command, (command[0], command[1], omega))[2]
+    return (command[0] + dvx, command[1] + dvy, turn)

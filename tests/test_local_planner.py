@@ -25,7 +25,7 @@ from fleet.scenario import (
     with_profile,
 )
 from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner
+from planner.dwa import DwaConfig, DwaPlanner, step_pose
 from planner.evasion import contact_times, evasive_index
 from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
@@ -411,3 +411,28 @@ def test_a_stall_among_agvs_is_a_jam_and_the_recoveries_start_again_before_faili
     jam = _fails_at(disc, np.zeros((0, 5)))  # another AGV
     assert alone < math.inf and jam < math.inf  # bounded either way
     assert jam > 2.5 * alone  # the sequence ran three times
+
+
+def test_the_last_metres_to_a_waiting_place_are_driven_straight_not_in_arcs():
+    # door n6 s0: DWA's arcs to a waiting place that moved made an AGV circle twice in
+    # front of a 1.0 m door; where the way is clear the AGV now drives there straight
+    grid = parse_text_grid("\n".join(["." * 12] * 12))
+    config = FusionConfig()
+    controller = FusionController(grid, (10.5, 10.5), config)
+    pose, command = (3.0, 3.0, math.pi / 4), (0.0, 0.0, 0.0)  # facing the goal
+    controller.start(pose)
+    controller.step(pose, command, 0.0)  # the initial turn: already aligned
+    bearing = math.pi / 4 + math.radians(60)  # the place: 60° to the left, 3 m away
+    hold = (3.0 + 3.0 * math.cos(bearing), 3.0 + 3.0 * math.sin(bearing))
+    worst = 0.0
+    for k in range(1, 300):
+        out = controller.step(pose, command, 0.1 * k, hold=hold)
+        assert out.status == "waiting"
+        command = out.command
+        pose = step_pose(pose, command, config.dwa.dt)
+        # distance from the line start -> hold
+        (ax, ay), (bx, by) = (3.0, 3.0), hold
+        worst = max(worst, abs((bx - ax) * (ay - pose[1]) - (ax - pose[0]) * (by - ay)) / 3.0)
+    assert math.dist(pose[:2], hold) < config.goal_tolerance
+    assert math.hypot(command[0], command[1]) < 1e-6  # standing there
+    assert worst < 0.05
