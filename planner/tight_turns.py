@@ -29,6 +29,7 @@ import numpy as np
 from planner.distance_field import DistanceField
 from planner.dwa import Command, DwaConfig, Pose, step_pose
 from planner.grid_map import Point
+from planner.path_metrics import heading_changes_deg
 from planner.recovery import towards
 from planner.route_check import route_samples
 
@@ -58,10 +59,10 @@ class Corner:
 
 
 def turn_angle(before: Point, node: Point, after: Point) -> float:
-    """The angle (rad, 0..pi) by which the route ``before`` → ``node`` → ``after`` turns."""
-    a = math.atan2(node[1] - before[1], node[0] - before[0])
-    b = math.atan2(after[1] - node[1], after[0] - node[0])
-    return abs(math.remainder(b - a, math.tau))
+    """The angle (rad, 0..pi) by which the route ``before`` → ``node`` → ``after`` turns
+    (0 where two of the points coincide: no heading to turn from)."""
+    change = heading_changes_deg([before, node, after])
+    return math.radians(abs(float(change[0]))) if len(change) else 0.0
 
 
 def room_ahead(field: DistanceField, radius: float, node: Point, after: Point) -> float:
@@ -161,5 +162,5 @@ def approach_command(
     scale = max(abs(dvx), abs(dvy)) / dv
     if scale > 1.0:
         dvx, dvy = dvx / scale, dvy / scale
-    turn = towards(config, command, (command[0], command[1], omega))[2]
-    return (command[0] + dvx, command[1] + dvy, turn)
+    dw = config.max_alpha * config.dt
+    return (command[0] + dvx, command[1] + dvy, command[2] + min(max(omega - command[2], -dw), dw))
