@@ -40,7 +40,9 @@ The default profile adds a term to Eq. (10), normalised like the others:
 ``on_route`` (the trajectory stays near the global route's current segment);
 and it picks, among the samples scoring near the best, the one that changes
 the last cycle's acceleration least (``steady_choice``), so the chosen
-acceleration stops flipping every cycle.
+acceleration stops flipping every cycle. Along the route it bounds the linear
+speed by the room to brake along the path rather than the clearance beside it
+(``planner.lane_speed``).
 
 Beyond the paper, for arriving (at 0.2 m/s² an AGV at 2 m/s needs 10 m to
 stop, and a 3 s rollout's end lies past a nearby target, so plain DWA circles
@@ -61,6 +63,7 @@ import numpy as np
 
 from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index
+from planner.lane_speed import ROUTE_TOLERANCE, braking_room, node_room, stop_room
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
 from planner.yielding import YIELD_SLACK, parked_clearance, walker_near, yield_horizon
 
@@ -325,14 +328,24 @@ def relevant_discs(
     return np.ascontiguousarray(discs[kept[np.argsort(gap_now[kept], kind="stable")]])
 
 
-def admissible_mask(config: DwaConfig, commands: np.ndarray, clearance: np.ndarray) -> np.ndarray:
-    """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance."""
+def admissible_mask(
+    config: DwaConfig,
+    commands: np.ndarray,
+    clearance: np.ndarray,
+    braking_room: np.ndarray | None = None,
+) -> np.ndarray:
+    """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance.
+
+    ``braking_room`` (the default profile's ``planner.lane_speed``) replaces the
+    clearance in the linear speed's bound; the turn rate's bound keeps the clearance.
+    """
     room = np.maximum(clearance, 0.0)
+    linear = room if braking_room is None else np.maximum(braking_room, 0.0)
     return (
         (clearance > 0.0)
         & (
             np.hypot(commands[:, 0], commands[:, 1])
-            <= np.sqrt(2.0 * room * config.max_accel) + _EPS
+            <= np.sqrt(2.0 * linear * config.max_accel) + _EPS
         )
         & (np.abs(commands[:, 2]) <= np.sqrt(2.0 * room * config.max_alpha) + _EPS)
     )
@@ -490,6 +503,7 @@ class DwaPlanner:
         segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
         route: list[tuple[float, float]] | None = None,
         walkers: np.ndarray | None = None,
+        lane_room: float | None = None,
     ) -> DwaResult:
         """One control cycle from ``pose`` with current ``command`` towards the local target.
 
@@ -504,6 +518,9 @@ class DwaPlanner:
         ``route``: the remaining global route from the AGV, along which head-on
         ``walkers`` (rows as ``moving``: the discs that do not avoid the AGV) are
         predicted, to get out of their way early (``planner.yielding``).
+        ``lane_room``: the braking room the route ahead grants (``planner.lane_speed``);
+        with a ``segment``, the samples that follow it are bounded by the room to brake
+        along their path instead of by their clearance (None: Eq. 7 for all).
         """
         cfg = self.config
         field = self.distance_field
@@ -515,10 +532,32 @@ class DwaPlanner:
             xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
         )
         static_best = float(clearance.max())
-        discs = relevant_discs(cfg, pose, xs, ys, discs, static_best)
-        if len(discs):
-            clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
-        mask = admissible_mask(cfg, commands, clearance)
+        braking = None
+        if lane_room is not None and segment is not None:
+            stop_at = target_xy if stop else None
+            braking = self._braking_room(commands, pose, command, lane_room, stop_at)
+        every_disc = discs
+        # the discs in reach of the fastest sample the lane admits (the fallback's choice
+        # between evading and braking looks at them), of which those that can lower a
+        # clearance below the best static one
+        bound = static_best if braking is None else max(static_best, float(braking.max()))
+        discs = relevant_discs(cfg, pose, xs, ys, every_disc, bound)
+        lowering = relevant_discs(cfg, pose, xs, ys, discs, static_best)
+        if len(lowering):
+            clearance = lower_by_discs(xs, ys, clearance, lowering, cfg.dt, cfg.radius)
+        if braking is not None:
+            (ax, ay), (bx, by) = segment
+            off = _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
+            # only the samples that follow the route get the room; the others (0: the
+            # discs' kernel skips them) keep Eq. (7)'s clearance, which the lane only
+            # ever relaxes
+            braking = np.where((off <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
+            # the gap to moving discs bounds the room too (Eq. 7 for them)
+            near = relevant_discs(cfg, pose, xs, ys, discs, float(braking.max()))
+            if len(near):
+                braking = lower_by_discs(xs, ys, braking, near, cfg.dt, cfg.radius)
+            braking = np.maximum(braking, clearance)
+        mask = admissible_mask(cfg, commands, clearance, braking)
         if self.behaviour.yield_early and walkers is not None and len(walkers):
             ends = (xs[:, -1], ys[:, -1])
             walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
@@ -579,6 +618,24 @@ class DwaPlanner:
             best = ok[int(np.argmax(g))]
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
+
+    def _braking_room(self, commands, pose, command, lane_room: float, stop_at) -> np.ndarray:
+        """(N,) each sample's room to brake along the route (``planner.lane_speed``) before
+        the moving discs: its horizon path's length, the route's ``lane_room`` (never less
+        than the hardest braking from the current ``command`` needs: a replan that turns
+        the route close ahead of a fast AGV leaves it braking along the route, not with
+        nothing admissible and the fallback's choice) and, when the AGV stops at
+        ``stop_at``, the room before what stands behind that place."""
+        cfg = self.config
+        speed = np.hypot(commands[:, 0], commands[:, 1])
+        horizon_s = cfg.steps * cfg.dt
+        hardest = braking_room(math.hypot(command[0], command[1]), cfg.max_accel, cfg.dt)
+        room = np.minimum(speed * horizon_s, max(lane_room, hardest))
+        if stop_at is not None:
+            behind = node_room(self.distance_field, cfg.radius, stop_at)
+            distance = math.dist(pose[:2], stop_at)
+            room = np.minimum(room, stop_room(distance, behind, speed, horizon_s))
+        return np.ascontiguousarray(room)
 
     def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
         """``mask`` narrowed to the samples whose end point no disc reaches before the

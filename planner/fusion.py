@@ -48,6 +48,8 @@ from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
+from planner.keep_right import agv_coming, right_offset, shifted_right
+from planner.lane_speed import braking_room, oncoming, route_room
 from planner.local_behaviour import local_behaviour
 from planner.parked_discs import blocking_cells
 from planner.path_metrics import distance_to_path
@@ -325,6 +327,8 @@ class FusionController:
             return self._turn(pose, command, now)
         target = self.targets[self.target_index]
         final = self.target_index == len(self.targets) - 1
+        if final and self.behaviour.tight_turns:  # the goal too: faced, then driven to straight
+            straight = self._straight_to(pose, command, target, moving, walkers)
         approach = (
             self.behaviour.final_approach
             and final
@@ -333,14 +337,14 @@ class FusionController:
         turn = self._turn_round(pose, command, target, moving)
         if turn is not None:
             return _step(turn, "driving", target)
-        if straight is not None:  # the last metres to a tight corner, straight
+        if straight is not None:  # the last metres to a tight corner or the goal, straight
             return _step(straight[0], "driving", target, straight[1], plan)
         reach = self.config.goal_tolerance if final else self._dwa_reach()
         result = self.dwa.plan(
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
-            approach=approach, segment=(self._segment_start(), target),
+            approach=approach, segment=self._segment(pose, target, moving, walkers),
             route=[position, *self.targets[self.target_index :]],
-            walkers=walkers,
+            walkers=walkers, lane_room=self._lane_room(pose, command, moving, walkers),
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)
@@ -364,6 +368,7 @@ class FusionController:
         result = self.dwa.plan(
             pose, command, hold, moving, reach=self.config.goal_tolerance, stop=True,
             previous=self._previous, approach=True, segment=(position, hold),
+            lane_room=self._lane_room(pose, command, moving, walkers, [hold]),
         )  # fmt: skip
         return _step(result.command, WAITING, hold, result.trajectory, plan)
 
@@ -399,6 +404,17 @@ class FusionController:
             for x, y, radius in discs
         )
 
+    def _segment(self, pose, target: Point, moving, walkers):
+        """The route's current segment for DWA's on-route term, shifted to the right while
+        another AGV comes the other way (``planner.keep_right``)."""
+        segment = (self._segment_start(), target)
+        if not self.behaviour.keep_right:
+            return segment
+        field, radius = self.dwa.distance_field, self.config.dwa.radius
+        if not agv_coming(pose[:2], segment, radius, _agvs_of(moving, walkers)):
+            return segment
+        return shifted_right(segment, right_offset(field, radius, segment))
+
     def _segment_start(self) -> Point:
         """Where the route's current segment starts: the previous key node, or where the
         AGV was when it planned."""
@@ -420,14 +436,22 @@ class FusionController:
     def _turn_round(self, pose, command, target, moving) -> tuple[float, float, float] | None:
         """Default profile, an AGV that cannot reverse and a target behind it: the turn on
         the spot towards it (DWA's arcs only circle, turning the body while driving on),
-        unless a walker is coming; None otherwise."""
+        unless a walker is coming; None otherwise. An AGV too fast to stop within its
+        clearance brakes straight first: turning while it braked from lane speed swept an
+        arc into a wall (a replan at 1.2 m/s that sent the route back the way it came),
+        while the way straight ahead is the old route's, clear at least to what made it
+        replan."""
         if not self.behaviour.turn_round or self.config.dwa.min_vx < 0:
             return None
         bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
         error = float(wrap_angle(bearing - pose[2]))
         if abs(error) <= BEHIND or self.dwa.threatened(pose, moving):
             return None
-        return turn_command(self.config.dwa, error, command)
+        cfg = self.config.dwa
+        stopping = math.hypot(command[0], command[1]) ** 2 / (2.0 * cfg.max_accel)
+        if stopping > self.dwa.distance_field.distance_at(pose[0], pose[1]) - cfg.radius:
+            return braking_command(cfg, command)
+        return turn_command(cfg, error, command)
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
         """The command and predicted path of the straight approach to a tight corner, when
@@ -449,6 +473,30 @@ class FusionController:
         if self.dwa.clearance_along(path, moving) <= 0.0:
             return None
         return approach_command(cfg, pose, command, node, cap), path
+
+    def _lane_room(self, pose, command, moving, walkers, nodes: list[Point] | None = None):
+        """The braking room the route ahead (or ``nodes``) grants DWA's samples that follow
+        it (``planner.lane_speed``). With a walker near or a disc coming (``oncoming``),
+        only the room to brake as hard as the limits allow from the current speed: the AGV
+        slows to Eq. (7)'s speed, keeping the room to yield or pass, instead of finding
+        nothing admissible at once."""
+        if not self.behaviour.lane_speed:
+            return None
+        cfg = self.config
+        horizon_s = cfg.dwa.steps * cfg.dwa.dt
+        if walker_near(pose, walkers) or oncoming(
+            pose, command, moving, cfg.dwa.max_accel, horizon_s
+        ):
+            return braking_room(math.hypot(command[0], command[1]), cfg.dwa.max_accel, cfg.dwa.dt)
+        if nodes is None:
+            nodes = self.targets[self.target_index :]
+        # a tight corner's bound applies from where its straight approach begins
+        corners = self.corners[self.target_index :] if len(nodes) > 1 else []
+        reaches = [cfg.approach_distance if c.stop else c.reach for c in corners]
+        horizon = cfg.dwa.max_speed**2 / (2.0 * cfg.dwa.max_accel)
+        return route_room(
+            self.dwa.distance_field, cfg.dwa.radius, (pose[0], pose[1]), nodes, reaches, horizon
+        )
 
     def _check_route(self, position: Point) -> PlanResult | None:
         """Replan at once when newly sensed obstacles block the remaining route."""
@@ -576,14 +624,20 @@ class FusionController:
         return now - self._best_time >= self.config.progress_window
 
 
+def _agvs_of(moving, walkers) -> np.ndarray:
+    """The rows of ``moving`` that are not walkers (``walkers`` are rows of it too): the
+    other AGVs."""
+    if moving is None or not len(moving):
+        return np.zeros((0, 5))
+    moving = np.asarray(moving, dtype=float).reshape(-1, 5)
+    if walkers is None or not len(walkers):
+        return moving
+    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+    is_walker = (moving[:, None, :] == walkers[None, :, :]).all(axis=2).any(axis=1)
+    return moving[~is_walker]
+
+
 def _agv_near(position: Point, moving, walkers) -> bool:
-    """Whether another AGV is within ``JAM_RANGE``: a moving disc that is not a walker (the
-    walkers are rows of ``moving`` too)."""
-
-    def near(discs) -> int:
-        if discs is None or not len(discs):
-            return 0
-        gap = np.hypot(discs[:, 0] - position[0], discs[:, 1] - position[1])
-        return int((gap < JAM_RANGE).sum())
-
-    return near(moving) > near(walkers)
+    """Whether another AGV (a moving disc that is not a walker) is within ``JAM_RANGE``."""
+    agvs = _agvs_of(moving, walkers)
+    return bool((np.hypot(agvs[:, 0] - position[0], agvs[:, 1] - position[1]) < JAM_RANGE).any())

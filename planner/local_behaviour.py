@@ -25,6 +25,8 @@ class LocalBehaviour:
     yield_early: bool  # keep to trajectories that leave the AGV off the walkers' way
     turn_round: bool  # a target behind an AGV that cannot reverse: turn on the spot first
     tight_turns: bool  # switch late, or stop and turn, where the route turns into a narrow stretch
+    lane_speed: bool  # on the route: speed bounded by the room to brake ahead, not beside
+    keep_right: bool  # another AGV coming the other way: follow the route shifted right
     route_weight: float  # weight of the term keeping trajectories on the global route
     face_travel_weight: float  # weight of the term facing the body along its travel
     steady_tolerance: float  # keep the acceleration unless this near the best (score spread)
@@ -46,6 +48,8 @@ def local_behaviour(profile: str, *, free_heading: bool = False) -> LocalBehavio
         yield_early=on,
         turn_round=on,
         tight_turns=on,
+        lane_speed=on,
+        keep_right=on,
         route_weight=0.3 if on else 0.0,
         face_travel_weight=0.3 if on and not free_heading else 0.0,
         steady_tolerance=STEADY_TOLERANCE if on else 0.0,

@@ -154,7 +154,11 @@ def approach_command(
         # of acceleration can make up for, so that the way stays straight
         moving = math.hypot(command[0], command[1])
         fastest = min(config.max_omega, config.max_accel / (2.0 * moving) if moving else math.inf)
-        omega = math.copysign(min(fastest, math.sqrt(2.0 * config.max_alpha * abs(error))), error)
+        # on the braking curve, and no faster than closes the error in one period: the
+        # curve alone overshoots a small error within a period, and omega flipped sign
+        # every tick on straight approaches (+-0.1 rad/s on the depot, at 60 deg/s limits)
+        turn = min(math.sqrt(2.0 * config.max_alpha * abs(error)), abs(error) / config.dt)
+        omega = math.copysign(min(fastest, turn), error)
     # the linear change scaled as a whole (not clipped per axis), so that the velocity turns
     # towards the node's direction along a straight line instead of bending round it
     dvx, dvy = max(vx, config.min_vx) - command[0], vy - command[1]

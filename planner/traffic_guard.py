@@ -174,17 +174,26 @@ class TrafficGuard:
         """``WAIT_BACK`` before the passage (``enter_at`` m along the route), and
         ``QUEUE_GAP`` further for each of the ``ahead`` AGVs queued before it on its side
         (a crowd at the mouth blocks the AGVs coming out), moved to the right of the
-        route where free, and off the routes ``keep_off`` (the holders' routes ahead)."""
+        route where free, and off the routes ``keep_off`` (the holders' routes ahead); where
+        no place with room is clear of them, the one furthest off them (falling back to the
+        route itself put an AGV waiting in a 1.5 m corridor's mouth on the holder's way)."""
         safety = self.costmap.clearance.safety_distance
+        furthest, best = -math.inf, None  # the place with room furthest off the holders' way
         for back in WAIT_BACK:
             back += ahead * QUEUE_GAP
             point, heading = _point_along(route, max(0.0, enter_at - back * safety))
             right = (math.sin(heading), -math.cos(heading))
             for aside in ASIDE:
                 place = (point[0] + right[0] * aside * safety, point[1] + right[1] * aside * safety)
-                clear = all(distance_to_path(r, place) >= 2 * safety for r in keep_off)
-                if clear and self._room_at(place) and self._room_at(_midpoint(point, place)):
+                if not (self._room_at(place) and self._room_at(_midpoint(point, place))):
+                    continue
+                off = min((distance_to_path(r, place) for r in keep_off), default=math.inf)
+                if off >= 2 * safety:
                     return place
+                if off > furthest:
+                    furthest, best = off, place
+        if best is not None:  # none clear of the holders' way: the least in it, not the route
+            return best
         return _point_along(route, max(0.0, enter_at - WAIT_BACK[0] * safety))[0]
 
     def _outside(self, position: Point, crossing: Crossing) -> Point:

@@ -50,7 +50,7 @@ from recordings.writer import RecordingWriter
 from tests.processes import agv_pid, fleet_processes
 
 CLI = [sys.executable, "-m", "fleet.cli"]
-SCENARIO = "corridor"  # 524 ticks
+SCENARIO = "corridor"  # 378 ticks
 NAMES = ("left", "right")
 ATTACK_AT_TICK = 60
 

@@ -3,6 +3,7 @@ switches late, or stops at the node and turns on the spot (``planner.tight_turns
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import replace
 
@@ -78,6 +79,21 @@ def test_the_straight_approach_ends_at_rest_on_the_node_within_the_limits():
     assert math.dist(pose[:2], node) < 0.05
     assert math.hypot(command[0], command[1]) < 1e-6
     assert approach_path(config, pose, command, node, config.max_speed).shape == (config.steps, 3)
+
+
+def test_the_straight_approach_holds_its_heading_without_chatter():
+    # at 60 deg/s and 0.5 s to reach it, the turn curve sqrt(2 alpha |error|) overshot a
+    # heading error of a few tenths of a degree each period: omega flipped sign every tick
+    config = DwaConfig(max_speed=1.2, max_accel=1.0, max_omega=math.radians(60), max_alpha=2.1)
+    pose, command, node = (0.0, 0.0, math.radians(3.0)), (0.4, 0.0, 0.0), (4.0, 0.0)
+    omegas = []
+    while math.dist(pose[:2], node) > 0.6:  # nearer than FACE_FROM the turn rate brakes
+        command = approach_command(config, pose, command, node, config.max_speed)
+        pose = step_pose(pose, command, config.dt)
+        omegas.append(command[2])
+    flips = sum(1 for a, b in itertools.pairwise(omegas) if a * b < 0)
+    assert flips <= 1
+    assert abs(math.remainder(pose[2], math.tau)) < math.radians(0.5)  # faces the node
 
 
 def test_an_agv_alone_turns_into_a_one_metre_corridor_and_arrives():
