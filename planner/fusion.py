@@ -49,7 +49,7 @@ from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
 from planner.keep_right import agv_coming, right_offset, shifted_right
-from planner.lane_speed import braking_room, oncoming, route_room
+from planner.lane_speed import oncoming, route_room
 from planner.local_behaviour import local_behaviour
 from planner.parked_discs import blocking_cells
 from planner.path_metrics import distance_to_path
@@ -477,9 +477,9 @@ class FusionController:
     def _lane_room(self, pose, command, moving, walkers, nodes: list[Point] | None = None):
         """The braking room the route ahead (or ``nodes``) grants DWA's samples that follow
         it (``planner.lane_speed``). With a walker near or a disc coming (``oncoming``),
-        only the room to brake as hard as the limits allow from the current speed: the AGV
-        slows to Eq. (7)'s speed, keeping the room to yield or pass, instead of finding
-        nothing admissible at once."""
+        none: DWA still grants the hardest braking from the current speed, so the AGV slows
+        to Eq. (7)'s speed, keeping the room to yield or pass, instead of finding nothing
+        admissible at once."""
         if not self.behaviour.lane_speed:
             return None
         cfg = self.config
@@ -487,7 +487,7 @@ class FusionController:
         if walker_near(pose, walkers) or oncoming(
             pose, command, moving, cfg.dwa.max_accel, horizon_s
         ):
-            return braking_room(math.hypot(command[0], command[1]), cfg.dwa.max_accel, cfg.dwa.dt)
+            return 0.0
         if nodes is None:
             nodes = self.targets[self.target_index :]
         # a tight corner's bound applies from where its straight approach begins

@@ -24,9 +24,11 @@ speed by the least of:
 - towards a place it stops at, the room left before what stands behind it once
   the constant-velocity horizon runs past (``stop_room``).
 
-The turn rate keeps Eq. (7)'s clearance bound, and off the route, or with a
-walker within ``WALKER_RANGE`` (the room to yield, as elsewhere), the paper's
-bound applies unchanged.
+The turn rate keeps Eq. (7)'s clearance bound; off the route the paper's bound
+applies unchanged. With a walker within ``WALKER_RANGE`` (the room to yield, as
+elsewhere) or a disc closing fast (``oncoming``) the route grants no room: only the
+hardest braking from the current speed (``braking_room``), which DWA always allows
+the samples on the route, until Eq. (7) holds again.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import numpy as np
 
 from planner.distance_field import DistanceField
 from planner.grid_map import Point
-from planner.path_metrics import heading_changes_deg
+from planner.path_metrics import turn_angle
 
 ROUTE_TOLERANCE = 0.25
 """m: a trajectory this near the route's current segment follows the route."""
@@ -74,8 +76,7 @@ def route_room(
         along += math.dist(previous, node)
         if i == len(nodes) - 1:
             return along
-        change = heading_changes_deg([previous, node, nodes[i + 1]])
-        if len(change) and math.radians(abs(float(change[0]))) > STRAIGHT_ON:
+        if turn_angle(previous, node, nodes[i + 1]) > STRAIGHT_ON:
             return max(0.0, along - reaches[i]) + node_room(field, radius, node)
         if along > horizon:
             return math.inf

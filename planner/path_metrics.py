@@ -42,6 +42,13 @@ def heading_changes_deg(path) -> np.ndarray:
     return np.degrees(change)
 
 
+def turn_angle(before, node, after) -> float:
+    """The angle (rad, 0..pi) by which the route ``before`` → ``node`` → ``after`` turns
+    (0 where two of the points coincide: no heading to turn from)."""
+    change = heading_changes_deg([before, node, after])
+    return math.radians(abs(float(change[0]))) if len(change) else 0.0
+
+
 def turning_times(path) -> int:
     """Number of vertices where the heading changes."""
     return int(np.count_nonzero(np.abs(heading_changes_deg(path)) > TURN_TOLERANCE_DEG))

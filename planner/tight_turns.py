@@ -29,7 +29,7 @@ import numpy as np
 from planner.distance_field import DistanceField
 from planner.dwa import Command, DwaConfig, Pose, step_pose
 from planner.grid_map import Point
-from planner.path_metrics import heading_changes_deg
+from planner.path_metrics import turn_angle
 from planner.recovery import towards
 from planner.route_check import route_samples
 
@@ -56,13 +56,6 @@ class Corner:
 
     reach: float  # switch to the next node within this distance
     stop: bool  # brake to the node, stop and turn on the spot towards the next
-
-
-def turn_angle(before: Point, node: Point, after: Point) -> float:
-    """The angle (rad, 0..pi) by which the route ``before`` → ``node`` → ``after`` turns
-    (0 where two of the points coincide: no heading to turn from)."""
-    change = heading_changes_deg([before, node, after])
-    return math.radians(abs(float(change[0]))) if len(change) else 0.0
 
 
 def room_ahead(field: DistanceField, radius: float, node: Point, after: Point) -> float:

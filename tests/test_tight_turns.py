@@ -15,6 +15,7 @@ from planner.dwa import DwaConfig, step_pose
 from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
 from planner.map_io import parse_text_grid
+from planner.path_metrics import turn_angle
 from planner.tight_turns import (
     MIN_REACH,
     TURN_ON_SPOT,
@@ -22,7 +23,6 @@ from planner.tight_turns import (
     approach_path,
     corner,
     room_ahead,
-    turn_angle,
 )
 
 RADIUS = 0.3
