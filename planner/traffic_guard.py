@@ -75,6 +75,15 @@ class TrafficGuard:
         self._since = 0
         self._phase = CLEAR
         self._hold: Point | None = None
+        self._parked: list[tuple[float, float, float]] = []
+
+    def park(self, discs) -> None:
+        """AGVs stopped for good (arrived, failed) at (x, y, radius): no waiting place within
+        a safety distance of them (the rule sent an AGV to wait where another stood at its
+        goal beside a door, and it circled the parked body for 10 s)."""
+        self._parked = [tuple(d) for d in discs]
+        if self._hold is not None and not self._room_at(self._hold):
+            self._hold = None
 
     def decide(
         self,
@@ -110,7 +119,7 @@ class TrafficGuard:
             if rival is None:
                 intent.phase = self._phase = GO  # inside, or allowed in: holds the passage
                 return self._decision(intent)
-            if self._phase != BACK:  # nose to nose inside: the later one backs out
+            if self._phase != BACK or self._hold is None:  # nose to nose: the later backs out
                 self._hold = self._outside(position, crossing)
             intent.phase = self._phase = BACK
             return self._decision(intent, self._hold, [rival])
@@ -228,11 +237,15 @@ class TrafficGuard:
         return away if all(self._room_at(p) for p in steps) else hold
 
     def _room_at(self, point: Point) -> bool:
+        """Outside every passage, a safety distance from walls and parked AGVs."""
         grid = self.costmap.grid
         cell = grid.cell_of(point)
         if not grid.contains_cell(cell) or self.passages.label[cell[1], cell[0]] >= 0:
             return False
-        return self.costmap.distance[cell[1], cell[0]] >= self.costmap.clearance.safety_distance
+        safety = self.costmap.clearance.safety_distance
+        if any(math.dist(point, (x, y)) - r < safety for x, y, r in self._parked):
+            return False
+        return self.costmap.distance[cell[1], cell[0]] >= safety
 
 
 def _point_along(route: list[Point], at: float) -> tuple[Point, float]:

@@ -3,6 +3,8 @@ that take turns in passages one AGV wide (in process; over Zenoh in test_traffic
 
 from __future__ import annotations
 
+import math
+
 from bridge import keys
 from bridge.messages import AgvCommand
 from fleet.runtime.agv_node import AgvNode
@@ -11,6 +13,7 @@ from fleet.runtime.world import World
 from fleet.scenario import load_scenario, parse_scenario
 from planner.clearance import Clearance
 from planner.costmap import Costmap
+from planner.dwa import DwaConfig
 from planner.map_io import parse_text_grid
 from planner.passages import NONE, Passages
 from planner.traffic import (
@@ -24,6 +27,7 @@ from planner.traffic import (
     may_enter,
     waiting_for,
 )  # fmt: skip
+from planner.traffic_guard import TrafficGuard
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 from recordings.rerun_view import save_rrd
@@ -117,6 +121,26 @@ def test_an_agv_stopping_inside_goes_alone_and_yielding_agvs_still_queue():
     backed_off = [claim("x", YIELD, 2, 1), claim("y", WAIT, 1, 2)]
     assert may_enter("x", backed_off) == (True, [])  # a yielding AGV is not a holder
     assert may_enter("y", backed_off) == (False, ["x"])
+
+
+def test_no_waiting_place_within_a_safety_distance_of_a_parked_agv():
+    """An AGV that arrived at its goal beside a 1 m door stood where the rule then sent the
+    next one to wait, and that one circled the parked body for 10 s (traffic_bench door
+    n6 s0)."""
+    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
+    guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
+    mid = 3.75
+    west = guard.passages.first_crossing([(18.0, mid), (2.0, mid)], lookahead=30.0)
+    holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, mid], [2.0, mid]])
+    position, route = (4.5, mid), [(2.0, mid), (18.0, mid)]
+    asked = guard.decide("x", 1, position, route, [holder], stalled=False)
+    waits = guard.decide("x", 2, position, route, [holder, asked.intent], stalled=False)
+    assert waits.intent.phase == WAIT and waits.hold is not None
+    safety = costmap.clearance.safety_distance
+    guard.park([(*waits.hold, WIDE.radius)])  # another AGV arrived right there
+    moved = guard.decide("x", 3, position, route, [holder, waits.intent], stalled=False)
+    assert moved.intent.phase == WAIT and moved.hold is not None
+    assert math.dist(moved.hold, waits.hold) - WIDE.radius >= safety
 
 
 # --- fleets ---------------------------------------------------------------------------

@@ -130,7 +130,10 @@ class AgvNode:
         names = frozenset(s.name for s in parked)
         if names != self._parked:
             self._parked = names
-            self.controller.park([(s.x, s.y, s.radius) for s in parked])
+            discs = [(s.x, s.y, s.radius) for s in parked]
+            self.controller.park(discs)
+            if self.guard is not None:
+                self.guard.park(discs)
 
     def _sense(self, tick: Tick, pose) -> None:
         if not tick.temporary:
