@@ -397,12 +397,16 @@ def facing(commands: np.ndarray) -> np.ndarray:
     return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
 
 
-def on_route(xs: np.ndarray, ys: np.ndarray, segment, cap: float) -> np.ndarray:
-    """cap - the largest distance of each trajectory (N, K) from the route ``segment``
-    (capped at ``cap``): trajectories that stay on the global route score highest, so
-    the AGV lines up with a narrow passage the route goes through before it gets there."""
+def route_offsets(xs: np.ndarray, ys: np.ndarray, segment) -> np.ndarray:
+    """(N,) the largest distance of each trajectory (N, K) from the route ``segment``."""
     (ax, ay), (bx, by) = segment
-    offsets = _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
+    return _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
+
+
+def on_route(offsets: np.ndarray, cap: float) -> np.ndarray:
+    """cap - each trajectory's ``route_offsets`` (capped at ``cap``): trajectories that stay
+    on the global route score highest, so the AGV lines up with a narrow passage the route
+    goes through before it gets there."""
     return cap - np.minimum(offsets, cap)
 
 
@@ -545,13 +549,14 @@ class DwaPlanner:
         lowering = relevant_discs(cfg, pose, xs, ys, discs, static_best)
         if len(lowering):
             clearance = lower_by_discs(xs, ys, clearance, lowering, cfg.dt, cfg.radius)
+        offsets = None  # how far each sample strays from the route: the lane and the score
+        if segment is not None and (braking is not None or self.behaviour.route_weight > 0):
+            offsets = route_offsets(xs, ys, segment)
         if braking is not None:
-            (ax, ay), (bx, by) = segment
-            off = _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
             # only the samples that follow the route get the room; the others (0: the
             # discs' kernel skips them) keep Eq. (7)'s clearance, which the lane only
             # ever relaxes
-            braking = np.where((off <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
+            braking = np.where((offsets <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
             # the gap to moving discs bounds the room too (Eq. 7 for them)
             near = relevant_discs(cfg, pose, xs, ys, discs, float(braking.max()))
             if len(near):
@@ -603,7 +608,7 @@ class DwaPlanner:
         )
         if segment is not None and self.behaviour.route_weight > 0:
             g = g + self.behaviour.route_weight * normalised(
-                on_route(xs[ok], ys[ok], segment, cfg.clearance_cap)
+                on_route(offsets[ok], cfg.clearance_cap)
             )
         standing = math.hypot(command[0], command[1]) < _EPS
         if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep

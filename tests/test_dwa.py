@@ -17,6 +17,7 @@ from planner.dwa import (
     lower_by_discs,
     on_route,
     rollout,
+    route_offsets,
     static_clearance,
     step_pose,
 )
@@ -159,11 +160,12 @@ def test_on_route_scores_the_largest_distance_from_the_route_segment():
     # running past its end to (6, 1): its largest distance is to the end point, sqrt(5)
     xs = np.array([np.linspace(0.5, 6.0, 12), np.linspace(0.5, 3.0, 12)])
     ys = np.array([np.full(12, 1.0), np.full(12, 0.5)])
-    got = on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 3.0)
+    offsets = route_offsets(xs, ys, ((0.0, 0.0), (4.0, 0.0)))
+    got = on_route(offsets, 3.0)
     assert got == pytest.approx([3.0 - math.sqrt(5.0), 2.5], abs=1e-12)
-    assert on_route(xs, ys, ((0.0, 0.0), (4.0, 0.0)), 1.0) == pytest.approx([0.0, 0.5])
+    assert on_route(offsets, 1.0) == pytest.approx([0.0, 0.5])
     # a segment of no length: the distance to its point
-    assert on_route(xs[1:, :1], ys[1:, :1], ((0.5, 0.0), (0.5, 0.0)), 3.0)[0] == 2.5
+    assert on_route(route_offsets(xs[1:, :1], ys[1:, :1], ((0.5, 0.0), (0.5, 0.0))), 3.0)[0] == 2.5
 
 
 def test_static_clearance_subtracts_the_radius():
