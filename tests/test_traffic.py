@@ -143,6 +143,31 @@ def test_no_waiting_place_within_a_safety_distance_of_a_parked_agv():
     assert math.dist(moved.hold, waits.hold) - WIDE.radius >= safety
 
 
+def test_only_an_agv_in_a_stuck_holders_way_yields_further_back():
+    """Every waiting AGV yielding for any stuck holder churned the crowd at a 1.0 m door
+    (traffic_bench door n12 s3: waiting AGVs looped through the rooms, up to 3.7 times
+    their routes); only those within two safety distances of its way ahead yield."""
+    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
+    mid = 3.75
+    route = [(2.0, mid), (18.0, mid)]
+    phases = {}
+    for label, holder_way in (
+        ("away", [[7.0, mid], [3.0, 6.5]]),
+        ("through", [[7.0, mid], [2.0, mid]]),
+    ):
+        guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
+        west = guard.passages.first_crossing([(18.0, mid), (2.0, mid)], lookahead=30.0)
+        holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, mid], [2.0, mid]])
+        asked = guard.decide("x", 1, (4.5, mid), route, [holder], stalled=False)
+        waits = guard.decide("x", 2, (4.5, mid), route, [holder, asked.intent], stalled=False)
+        assert waits.intent.phase == WAIT
+        stuck = Intent("h", 2, GO, west.passage, west.exit, 0, stalled=True, route=holder_way)
+        phases[label] = guard.decide("x", 3, (4.5, mid), route, [stuck, waits.intent], False)
+    assert phases["away"].intent.phase == WAIT  # its way leaves the corridor northwards
+    assert phases["through"].intent.phase == YIELD
+    assert math.dist(phases["through"].hold, (4.5, mid)) > 0.5  # moved further back
+
+
 # --- fleets ---------------------------------------------------------------------------
 def corridor_swap(cells: int, agvs: list[tuple[str, tuple, tuple]]) -> str:
     rows = two_rooms(cells)
