@@ -7,8 +7,8 @@ and applies ``planner.traffic.may_enter`` to the fleet's intents of the last tic
 Not allowed: the AGV holds at a *waiting place* ``WAIT_BACK`` safety distances
 before the passage along its route, moved off the route to its right where the
 costmap has room, so that AGVs coming out of the passage pass it. While it waits and
-a holder of the passage reports no progress (a body in its way), the waiting place
-moves back, away from the passage: it yields.
+a holder of the passage reports no progress (a body in its way), the waiting place of
+an AGV in that holder's way moves back, away from the passage: it yields.
 """
 
 from __future__ import annotations
@@ -46,6 +46,9 @@ ASIDE = (2.0, 1.5, 1.0, 0.0)
 AGVs leaving the passage along the route pass it."""
 QUEUE_GAP = 2.0
 """Safety distances between the waiting places of AGVs queued on the same side."""
+IN_WAY = 2.0
+"""Safety distances: a place this near a holder's way ahead is in it (two bodies with
+their margins)."""
 ROUTE_POINTS = 5
 """Route points ahead shared in an intent (the AGV's position, then key nodes)."""
 
@@ -142,7 +145,7 @@ class TrafficGuard:
         if (
             self._hold is not None
             and not self._moved
-            and any(distance_to_path(r, self._hold) < 2 * safety for r in keep_off)
+            and any(distance_to_path(r, self._hold) < IN_WAY * safety for r in keep_off)
         ):
             self._hold, self._moved = None, True  # a holder's way goes through it: once
         if self._hold is None:
@@ -158,11 +161,11 @@ class TrafficGuard:
         return self._decision(intent, self._hold, blockers)
 
     def _in_way_of(self, stuck: list[str], intents: list[Intent], position: Point) -> bool:
-        """Whether this AGV, or its waiting place, is within two safety distances of the way
-        ahead of a stuck holder: only then does it yield further back. Every waiting AGV
+        """Whether this AGV, or its waiting place, is ``IN_WAY`` of the way ahead of a stuck
+        holder: only then does it yield further back. Every waiting AGV
         yielding for any stuck holder churned the crowd at a 1.0 m door (door n12 s3:
         waiting AGVs looped through the rooms, up to 3.7 times their routes)."""
-        reach = 2 * self.costmap.clearance.safety_distance
+        reach = IN_WAY * self.costmap.clearance.safety_distance
         places = [position] if self._hold is None else [position, self._hold]
         return any(
             i.name in stuck and len(i.route) > 1
@@ -212,7 +215,7 @@ class TrafficGuard:
                 if not (self._room_at(place) and self._room_at(_midpoint(point, place))):
                     continue
                 off = min((distance_to_path(r, place) for r in keep_off), default=math.inf)
-                if off >= 2 * safety:
+                if off >= IN_WAY * safety:
                     return place
                 if off > furthest:
                     furthest, best = off, place

@@ -4,6 +4,7 @@ that take turns in passages one AGV wide (in process; over Zenoh in test_traffic
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from bridge import keys
 from bridge.messages import AgvCommand
@@ -123,23 +124,33 @@ def test_an_agv_stopping_inside_goes_alone_and_yielding_agvs_still_queue():
     assert may_enter("y", backed_off) == (False, ["x"])
 
 
+MID = 3.75  # y of the two rooms' corridor midline
+EASTWARD = [(2.0, MID), (18.0, MID)]
+
+
+def _waiting_east_of_a_holder():
+    """A guard for AGV x at (4.5, MID) driving east through the corridor while h, going
+    west, holds it: x asked, then waits. Returns the guard, x's last decision and the
+    holder's passage and exit."""
+    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
+    guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
+    west = guard.passages.first_crossing([(18.0, MID), (2.0, MID)], lookahead=30.0)
+    holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, MID], [2.0, MID]])
+    asked = guard.decide("x", 1, (4.5, MID), EASTWARD, [holder], stalled=False)
+    waits = guard.decide("x", 2, (4.5, MID), EASTWARD, [holder, asked.intent], stalled=False)
+    assert waits.intent.phase == WAIT and waits.hold is not None
+    return guard, waits, holder
+
+
 def test_no_waiting_place_within_a_safety_distance_of_a_parked_agv():
     """An AGV that arrived at its goal beside a 1 m door stood where the rule then sent the
     next one to wait, and that one circled the parked body for 10 s (traffic_bench door
     n6 s0)."""
-    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
-    guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
-    mid = 3.75
-    west = guard.passages.first_crossing([(18.0, mid), (2.0, mid)], lookahead=30.0)
-    holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, mid], [2.0, mid]])
-    position, route = (4.5, mid), [(2.0, mid), (18.0, mid)]
-    asked = guard.decide("x", 1, position, route, [holder], stalled=False)
-    waits = guard.decide("x", 2, position, route, [holder, asked.intent], stalled=False)
-    assert waits.intent.phase == WAIT and waits.hold is not None
-    safety = costmap.clearance.safety_distance
+    guard, waits, holder = _waiting_east_of_a_holder()
     guard.park([(*waits.hold, WIDE.radius)])  # another AGV arrived right there
-    moved = guard.decide("x", 3, position, route, [holder, waits.intent], stalled=False)
+    moved = guard.decide("x", 3, (4.5, MID), EASTWARD, [holder, waits.intent], stalled=False)
     assert moved.intent.phase == WAIT and moved.hold is not None
+    safety = guard.costmap.clearance.safety_distance
     assert math.dist(moved.hold, waits.hold) - WIDE.radius >= safety
 
 
@@ -147,25 +158,17 @@ def test_only_an_agv_in_a_stuck_holders_way_yields_further_back():
     """Every waiting AGV yielding for any stuck holder churned the crowd at a 1.0 m door
     (traffic_bench door n12 s3: waiting AGVs looped through the rooms, up to 3.7 times
     their routes); only those within two safety distances of its way ahead yield."""
-    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
-    mid = 3.75
-    route = [(2.0, mid), (18.0, mid)]
     phases = {}
     for label, holder_way in (
-        ("away", [[7.0, mid], [3.0, 6.5]]),
-        ("through", [[7.0, mid], [2.0, mid]]),
+        ("away", [[7.0, MID], [3.0, 6.5]]),
+        ("through", [[7.0, MID], [2.0, MID]]),
     ):
-        guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
-        west = guard.passages.first_crossing([(18.0, mid), (2.0, mid)], lookahead=30.0)
-        holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, mid], [2.0, mid]])
-        asked = guard.decide("x", 1, (4.5, mid), route, [holder], stalled=False)
-        waits = guard.decide("x", 2, (4.5, mid), route, [holder, asked.intent], stalled=False)
-        assert waits.intent.phase == WAIT
-        stuck = Intent("h", 2, GO, west.passage, west.exit, 0, stalled=True, route=holder_way)
-        phases[label] = guard.decide("x", 3, (4.5, mid), route, [stuck, waits.intent], False)
+        guard, waits, holder = _waiting_east_of_a_holder()
+        stuck = replace(holder, tick=2, stalled=True, route=holder_way)
+        phases[label] = guard.decide("x", 3, (4.5, MID), EASTWARD, [stuck, waits.intent], False)
     assert phases["away"].intent.phase == WAIT  # its way leaves the corridor northwards
     assert phases["through"].intent.phase == YIELD
-    assert math.dist(phases["through"].hold, (4.5, mid)) > 0.5  # moved further back
+    assert math.dist(phases["through"].hold, (4.5, MID)) > 0.5  # moved further back
 
 
 # --- fleets ---------------------------------------------------------------------------
