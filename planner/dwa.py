@@ -122,6 +122,11 @@ class DwaConfig:
         """Rollout steps over the horizon."""
         return max(1, round(self.predict_time / self.dt))
 
+    @property
+    def horizon_s(self) -> float:
+        """s: the rollout's length in time (``steps`` periods)."""
+        return self.steps * self.dt
+
 
 def step_pose(pose: Pose, command: Command, dt: float) -> Pose:
     """Eq. (4): ``pose`` after ``dt`` under the body-frame ``command``, theta in [-pi, pi]."""
@@ -322,7 +327,7 @@ def relevant_discs(
     if not len(discs):
         return discs
     agv_reach = math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
-    disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * (config.steps * config.dt)
+    disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * config.horizon_s
     gap_now = np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
     (kept,) = np.nonzero(gap_now - agv_reach - disc_reach < bound)
     return np.ascontiguousarray(discs[kept[np.argsort(gap_now[kept], kind="stable")]])
@@ -633,13 +638,12 @@ class DwaPlanner:
         ``stop_at``, the room before what stands behind that place."""
         cfg = self.config
         speed = np.hypot(commands[:, 0], commands[:, 1])
-        horizon_s = cfg.steps * cfg.dt
         hardest = braking_room(math.hypot(command[0], command[1]), cfg.max_accel, cfg.dt)
-        room = np.minimum(speed * horizon_s, max(lane_room, hardest))
+        room = np.minimum(speed * cfg.horizon_s, max(lane_room, hardest))
         if stop_at is not None:
             behind = node_room(self.distance_field, cfg.radius, stop_at)
             distance = math.dist(pose[:2], stop_at)
-            room = np.minimum(room, stop_room(distance, behind, speed, horizon_s))
+            room = np.minimum(room, stop_room(distance, behind, speed, cfg.horizon_s))
         return np.ascontiguousarray(room)
 
     def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
@@ -650,7 +654,7 @@ class DwaPlanner:
         cfg = self.config
         speed = math.hypot(command[0], command[1])
         horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
-        later = parked_clearance(*ends, discs, route, cfg.steps * cfg.dt, horizon, cfg.radius)
+        later = parked_clearance(*ends, discs, route, cfg.horizon_s, horizon, cfg.radius)
         clear = mask & (later > 0.0)
         if clear.any():
             return clear

@@ -483,9 +483,8 @@ class FusionController:
         if not self.behaviour.lane_speed:
             return None
         cfg = self.config
-        horizon_s = cfg.dwa.steps * cfg.dwa.dt
         if walker_near(pose, walkers) or oncoming(
-            pose, command, moving, cfg.dwa.max_accel, horizon_s
+            pose, command, moving, cfg.dwa.max_accel, cfg.dwa.horizon_s
         ):
             return 0.0
         if nodes is None:

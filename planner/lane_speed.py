@@ -39,6 +39,7 @@ import numpy as np
 
 from planner.distance_field import DistanceField
 from planner.grid_map import Point
+from planner.motion import world_velocity
 from planner.path_metrics import turn_angle
 
 ROUTE_TOLERANCE = 0.25
@@ -100,8 +101,7 @@ def oncoming(pose, command, moving, max_accel: float, horizon_s: float) -> bool:
     if moving is None or not len(moving):
         return False
     discs = np.asarray(moving, dtype=float).reshape(-1, 5)
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    vx, vy = command[0] * c - command[1] * s, command[0] * s + command[1] * c
+    vx, vy = world_velocity(pose[2], command[0], command[1], 0.0, 0.0)  # as it drives on
     dx, dy = discs[:, 0] - pose[0], discs[:, 1] - pose[1]
     distance = np.maximum(np.hypot(dx, dy), 1e-9)
     closing = ((vx - discs[:, 2]) * dx + (vy - discs[:, 3]) * dy) / distance
