@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import pytest
+
 from bridge import keys
 from bridge.messages import AgvCommand
 from fleet.runtime.agv_node import AgvNode
@@ -19,6 +21,7 @@ from planner.map_io import parse_text_grid
 from planner.passages import NONE, Passages
 from planner.traffic import (
     BACK,
+    CLEAR,
     GO,
     REQUEST,
     WAIT,
@@ -28,7 +31,7 @@ from planner.traffic import (
     may_enter,
     waiting_for,
 )  # fmt: skip
-from planner.traffic_guard import TrafficGuard
+from planner.traffic_guard import QUEUE_GAP, TrafficGuard
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 from recordings.rerun_view import save_rrd
@@ -169,6 +172,54 @@ def test_only_an_agv_in_a_stuck_holders_way_yields_further_back():
     assert phases["away"].intent.phase == WAIT  # its way leaves the corridor northwards
     assert phases["through"].intent.phase == YIELD
     assert math.dist(phases["through"].hold, (4.5, MID)) > 0.5  # moved further back
+
+
+def test_a_waiting_agv_keeps_its_claim_beyond_the_request_distance():
+    """A waiting place down a queue, or a replan from it, can put the passage beyond the
+    request distance; dropping the claim there sent the AGV on towards the passage to ask
+    again, last (traffic_bench door n12 s3: waiting AGVs looped through the rooms). A
+    waiting AGV keeps its claim, with the tick it first asked, out to twice that distance;
+    an AGV that has not asked does not claim so far ahead."""
+    guard, waits, holder = _waiting_east_of_a_holder()
+    detour = [(4.5, MID), (2.5, 1.5), (2.5, MID), (18.0, MID)]
+    far = guard.passages.first_crossing(detour, lookahead=30.0).enter_at
+    assert guard.request_distance < far < 2 * guard.request_distance
+    guard.replanned()
+    kept = guard.decide("x", 3, (4.5, MID), detour, [holder, waits.intent], stalled=False)
+    assert kept.intent.phase == WAIT and kept.intent.since == waits.intent.since
+    let_in = guard.decide("x", 4, (4.5, MID), detour, [kept.intent], stalled=False)
+    assert let_in.intent.phase == GO and let_in.rejoin  # the holder left: x goes ...
+    guard.replanned()
+    going = guard.decide("x", 5, (4.5, MID), detour, [let_in.intent], stalled=False)
+    assert going.intent.phase == GO  # ... and still holds after its replan from afar
+    fresh = TrafficGuard(guard.costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
+    assert fresh.decide("z", 3, (4.5, MID), detour, [holder], stalled=False).intent.phase == CLEAR
+
+
+def test_the_waiting_place_moves_up_as_the_queue_does():
+    """A waiting place ``QUEUE_GAP`` further back for each AGV queued before it stayed
+    there when those went in, and the next AGV to queue was sent to the same place."""
+    room = "#" + "." * 24 + "#" * 10 + "." * 24 + "#"  # rooms 12 m wide, the corridor 5 m
+    corridor = "#" + "." * 58 + "#"
+    text = "\n".join(["#" * 60, *[room] * 5, *[corridor] * 3, *[room] * 5, "#" * 60])
+    guard = TrafficGuard(
+        Costmap.build(parse_text_grid(text, resolution=0.5), WIDE),
+        DwaConfig(max_speed=1.0, max_accel=0.5),
+    )
+    east_route = [(1.0, MID), (29.0, MID)]
+    west = guard.passages.first_crossing([(29.0, MID), (1.0, MID)], lookahead=40.0)
+    east = guard.passages.first_crossing(east_route, lookahead=40.0)
+    holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[20, MID], [12, MID], [5, 6.5]])
+    first = Intent(
+        "a", 1, WAIT, east.passage, east.exit, 0, route=[[12, MID], [29, MID]], entry=east.entry
+    )
+    asked = guard.decide("x", 1, (8.0, MID), east_route, [holder, first], stalled=False)
+    behind = guard.decide("x", 2, (8.0, MID), east_route, [holder, first, asked.intent], False)
+    went_in = replace(first, tick=2, phase=GO)
+    moved = guard.decide("x", 3, (8.0, MID), east_route, [holder, went_in, behind.intent], False)
+    assert behind.intent.phase == moved.intent.phase == WAIT
+    safety = guard.costmap.clearance.safety_distance
+    assert moved.hold[0] - behind.hold[0] == pytest.approx(QUEUE_GAP * safety)  # moved up
 
 
 # --- fleets ---------------------------------------------------------------------------
