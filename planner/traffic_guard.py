@@ -83,6 +83,7 @@ class TrafficGuard:
         self._hold: Point | None = None
         self._ahead = 0  # AGVs queued before it on its side when its waiting place was chosen
         self._parked: list[tuple[float, float, float]] = []
+        self._waiting: list[tuple[float, float, float]] = []  # other AGVs held, last tick
 
     def park(self, discs) -> None:
         """AGVs stopped for good (arrived, failed) at (x, y, radius): no waiting place within
@@ -106,6 +107,10 @@ class TrafficGuard:
         that segment); ``intents`` are the fleet's of the last tick (the world's tick
         carries them)."""
         shared = [[round(x, 2), round(y, 2)] for x, y in [position, *route[1:ROUTE_POINTS]]]
+        radius = self.costmap.clearance.radius
+        self._waiting = [
+            (*i.route[0], radius) for i in intents if i.name != name and i.phase in HELD and i.route
+        ]
         along = _projection(route, position)
         crossing = self.passages.first_crossing(route, self._reach(), along)
         beyond = crossing is not None and crossing.enter_at > self.request_distance
@@ -267,13 +272,17 @@ class TrafficGuard:
         return mouth
 
     def _room_at(self, point: Point) -> bool:
-        """Outside every passage, a safety distance from walls and parked AGVs."""
+        """Outside every passage, a safety distance from walls, parked AGVs and AGVs held
+        at waiting places (each chose its place along its own route, and at a crowded
+        1.0 m door one was sent where another already stood, and circled it)."""
         grid = self.costmap.grid
         cell = grid.cell_of(point)
         if not grid.contains_cell(cell) or self.passages.label[cell[1], cell[0]] >= 0:
             return False
         safety = self.costmap.clearance.safety_distance
-        if any(math.dist(point, (x, y)) - r < safety for x, y, r in self._parked):
+        if any(
+            math.dist(point, (x, y)) - r < safety for x, y, r in (*self._parked, *self._waiting)
+        ):
             return False
         return self.costmap.distance[cell[1], cell[0]] >= safety
 

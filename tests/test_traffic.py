@@ -131,16 +131,17 @@ MID = 3.75  # y of the two rooms' corridor midline
 EASTWARD = [(2.0, MID), (18.0, MID)]
 
 
-def _waiting_east_of_a_holder():
+def _waiting_east_of_a_holder(others=()):
     """A guard for AGV x at (4.5, MID) driving east through the corridor while h, going
-    west, holds it: x asked, then waits. Returns the guard, x's last decision and the
-    holder's passage and exit."""
+    west, holds it: x asked, then waits (``others``: more intents of the fleet). Returns
+    the guard, x's last decision and the holder's passage and exit."""
     costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
     guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
     west = guard.passages.first_crossing([(18.0, MID), (2.0, MID)], lookahead=30.0)
     holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, MID], [2.0, MID]])
-    asked = guard.decide("x", 1, (4.5, MID), EASTWARD, [holder], stalled=False)
-    waits = guard.decide("x", 2, (4.5, MID), EASTWARD, [holder, asked.intent], stalled=False)
+    asked = guard.decide("x", 1, (4.5, MID), EASTWARD, [holder, *others], stalled=False)
+    fleet = [holder, asked.intent, *others]
+    waits = guard.decide("x", 2, (4.5, MID), EASTWARD, fleet, stalled=False)
     assert waits.intent.phase == WAIT and waits.hold is not None
     return guard, waits, holder
 
@@ -155,6 +156,17 @@ def test_no_waiting_place_within_a_safety_distance_of_a_parked_agv():
     assert moved.intent.phase == WAIT and moved.hold is not None
     safety = guard.costmap.clearance.safety_distance
     assert math.dist(moved.hold, waits.hold) - WIDE.radius >= safety
+
+
+def test_no_waiting_place_within_a_safety_distance_of_another_waiting_agv():
+    """Waiting places were chosen along each AGV's own route, and at a crowded 1.0 m door
+    one fell where another AGV already waited, and the newcomer circled it (door n12 s3:
+    R5 for 10 s)."""
+    _, alone, _ = _waiting_east_of_a_holder()
+    standing = Intent("w", 1, WAIT, 7, 0, 0, route=[list(alone.hold)])  # waits for another
+    _, waits, _ = _waiting_east_of_a_holder(others=[standing])
+    safety = WIDE.safety_distance
+    assert math.dist(waits.hold, alone.hold) - WIDE.radius >= safety
 
 
 def test_only_an_agv_in_a_stuck_holders_way_yields_further_back():
