@@ -42,6 +42,10 @@ from fleet.scenario import Scenario  # noqa: E402
 
 _SOLO_CACHE: dict[tuple[str, str], dict] = {}
 
+DETOUR = 1.4
+"""An AGV that drove more than this times the length of its first route is counted: a loop
+or a detour a warehouse engineer would ask about (waiting aside adds a little)."""
+
 
 def solo_run(scenario: Scenario, name: str) -> dict:
     """AGV ``name`` of ``scenario`` alone on the same map (cached per case and AGV)."""
@@ -100,6 +104,9 @@ def run_case(family: str, seed: int) -> dict:
         "makespan_over_longest_solo": None if ratio_longest is None else round(ratio_longest, 4),
         "solo_failures": sorted(n for n, s in solos.items() if s["time"] is None),
         "waiting": waits,
+        "driven_over_route": {
+            a.name: round(a.distance / a.route_length, 3) for a in summary.agvs if a.route_length
+        },
         "statuses": {a.name: a.status for a in summary.agvs},
         "failures": {a.name: a.failure for a in summary.agvs if a.failure},
         "outcome": outcome(summary),
@@ -134,6 +141,7 @@ def family_rows(results: list[dict]) -> list[dict]:
         waits = [w for r in runs for w in r["waiting"].values()]
         ratios = [r["makespan_over_sum_solo"] for r in runs if r["makespan_over_sum_solo"]]
         longest = [r["makespan_over_longest_solo"] for r in runs if r["makespan_over_longest_solo"]]
+        detours = [d for r in runs for d in r["driven_over_route"].values()]
         limits = sorted({r["time_limit"] for r in runs})
         rows.append(
             {
@@ -150,6 +158,8 @@ def family_rows(results: list[dict]) -> list[dict]:
                 "median_makespan_over_longest_solo": _median(longest),
                 "mean_wait_s": statistics.fmean(waits) if waits else None,
                 "max_wait_s": max(waits) if waits else None,
+                "worst_driven_over_route": max(detours) if detours else None,
+                "agvs_over_detour": sum(d > DETOUR for d in detours),
                 "solo_failures": sum(len(r["solo_failures"]) for r in runs),
                 "time_limit_s": [limits[0], limits[-1]],
             }
@@ -166,7 +176,8 @@ def print_table(rows: list[dict]) -> None:
         f"{'family':<18} {'runs':>4} {'AGVs':>4} {'arrived':>7} {'all':>3} {'failed':>6} "
         f"{'coll':>4} "
         f"{'limit':>5} {'mk/sum med':>10} {'mk/sum max':>10} {'mk/long med':>11} "
-        f"{'wait mean':>9} {'wait max':>8} {'solo fail':>9} {'time limit s':>12}"
+        f"{'wait mean':>9} {'wait max':>8} {'drive max':>9} {f'>{DETOUR:g}x':>5} "
+        f"{'solo fail':>9} {'time limit s':>12}"
     )
     print(header)
     print("-" * len(header))
@@ -179,6 +190,7 @@ def print_table(rows: list[dict]) -> None:
             f"{_f(r['worst_makespan_over_sum_solo'], '.3f'):>10} "
             f"{_f(r['median_makespan_over_longest_solo'], '.2f'):>11} "
             f"{_f(r['mean_wait_s'], '.1f'):>9} {_f(r['max_wait_s'], '.1f'):>8} "
+            f"{_f(r['worst_driven_over_route'], '.2f'):>9} {r['agvs_over_detour']:>5} "
             f"{r['solo_failures']:>9} {f'{lo:g}-{hi:g}':>12}"
         )
     print(
@@ -186,7 +198,9 @@ def print_table(rows: list[dict]) -> None:
         "up; coll: runs with a collision; limit: runs that reached their time limit; mk/sum,\n"
         "mk/long: makespan (last arrival) over the sum of the solo run times and over the longest\n"
         "solo run, runs where every AGV arrived only; wait: seconds per AGV held outside a\n"
-        "passage by the traffic rule (status 'waiting'); solo fail: AGVs that do not arrive alone."
+        "passage by the traffic rule (status 'waiting'); drive max: the most an AGV drove over\n"
+        f"the length of its first route (loops and detours show here); >{DETOUR:g}x: AGVs that\n"
+        "drove more than that; solo fail: AGVs that do not arrive alone."
     )
 
 
