@@ -10,8 +10,8 @@ costmap has room, so that AGVs coming out of the passage pass it; each AGV queue
 before it on its side puts it ``QUEUE_GAP`` further back, and it moves up as they go
 in. While it waits and a holder of the passage reports no progress (a body in its way),
 an AGV in that holder's way moves one queue place back, off that holder's way: it
-yields. Once it waits, its claim reaches twice the request distance, so that a place
-far down the queue does not drop it.
+yields. Once it waits or is let in, its claim reaches twice the request distance, so
+that neither a place far down the queue nor the route planned from there drops it.
 """
 
 from __future__ import annotations
