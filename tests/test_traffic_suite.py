@@ -1,11 +1,13 @@
 """The fast subset of the traffic stress suite (benchmarks/traffic_cases.py) as tests:
-every AGV arrives, nothing collides, no run reaches its time limit. The whole suite and
-the cases that still miss are in benchmarks/traffic_bench.py and benchmarks/README.md."""
+every AGV arrives, nothing collides, no run reaches its time limit, and no AGV loops (drives
+more than ``DETOUR`` times its first route). The whole suite and the cases that still
+miss are in benchmarks/traffic_bench.py and benchmarks/README.md."""
 
 from __future__ import annotations
 
 import pytest
 
+from benchmarks.traffic_bench import DETOUR
 from benchmarks.traffic_cases import make_case
 from fleet.runtime.inprocess import run_in_process
 
@@ -20,5 +22,7 @@ def test_every_agv_arrives_without_contact(family, seed):
     summary = run_in_process(case.scenario)
     assert summary.success, summary.table()
     assert summary.end_reason == "every AGV arrived"
+    detours = {a.name: round(a.distance / a.route_length, 2) for a in summary.agvs}
+    assert max(detours.values()) <= DETOUR, detours  # waiting aside, yes; loops, no
     if family == "door":  # one side waited while the other went through
         assert sum(a.waiting_time > 0 for a in summary.agvs) >= 2
