@@ -139,6 +139,6 @@ def waiting_for(intents: list[Intent]) -> dict[str, list[str]]:
     return graph
 
 
-def stuck_holders(passage: int, intents: list[Intent]) -> list[str]:
+def stuck_holders(passage: int, intents: list[Intent]) -> list[Intent]:
     """Holders of ``passage`` that report no progress: a body is in their way."""
-    return [h.name for h in holders(passage, intents) if h.stalled]
+    return [h for h in holders(passage, intents) if h.stalled]

@@ -107,10 +107,6 @@ class TrafficGuard:
         that segment); ``intents`` are the fleet's of the last tick (the world's tick
         carries them)."""
         shared = [[round(x, 2), round(y, 2)] for x, y in [position, *route[1:ROUTE_POINTS]]]
-        radius = self.costmap.clearance.radius
-        self._waiting = [
-            (*i.route[0], radius) for i in intents if i.name != name and i.phase in HELD and i.route
-        ]
         along = _projection(route, position)
         crossing = self.passages.first_crossing(route, self._reach(), along)
         beyond = crossing is not None and crossing.enter_at > self.request_distance
@@ -121,6 +117,10 @@ class TrafficGuard:
         if crossing is None:
             self._claim, self._phase = None, CLEAR
             return self._decision(Intent(name, tick, CLEAR, stalled=stalled, route=shared))
+        radius = self.costmap.clearance.radius  # only a claim chooses places: not when clear
+        self._waiting = [
+            (*i.route[0], radius) for i in intents if i.name != name and i.phase in HELD and i.route
+        ]
         claim = (crossing.passage, crossing.exit)
         if claim != self._claim:
             self._claim, self._since, self._phase, self._hold = claim, tick, REQUEST, None
@@ -168,10 +168,9 @@ class TrafficGuard:
             self._ahead = ahead
             self._hold = self._waiting_place(route, along + crossing.enter_at, ahead, keep_off)
         stuck = stuck_holders(crossing.passage, intents)
-        if self._phase not in (YIELD, BACK) and self._in_way_of(stuck, intents, position):
-            stuck_ways = [i.route for i in intents if i.name in stuck]
+        if self._phase not in (YIELD, BACK) and self._in_way_of(stuck, position):
             self._hold = self._waiting_place(
-                route, along + crossing.enter_at, self._ahead + 1, stuck_ways
+                route, along + crossing.enter_at, self._ahead + 1, [h.route for h in stuck]
             )  # one place further back in the queue, off the stuck holder's way
             intent.phase = self._phase = YIELD
         elif self._phase not in (YIELD, BACK):
@@ -187,7 +186,7 @@ class TrafficGuard:
         its route, looping through the right-hand room)."""
         return self.request_distance * (2.0 if self._phase in (WAIT, YIELD, GO) else 1.0)
 
-    def _in_way_of(self, stuck: list[str], intents: list[Intent], position: Point) -> bool:
+    def _in_way_of(self, stuck: list[Intent], position: Point) -> bool:
         """Whether this AGV, or its waiting place, is ``IN_WAY`` of the way ahead of a stuck
         holder: only then does it yield further back. Every waiting AGV
         yielding for any stuck holder churned the crowd at a 1.0 m door (door n12 s3:
@@ -195,10 +194,9 @@ class TrafficGuard:
         reach = IN_WAY * self.costmap.clearance.safety_distance
         places = [position] if self._hold is None else [position, self._hold]
         return any(
-            i.name in stuck and len(i.route) > 1
-            and any(distance_to_path(i.route, p) < reach for p in places)
-            for i in intents
-        )  # fmt: skip
+            len(h.route) > 1 and any(distance_to_path(h.route, p) < reach for p in places)
+            for h in stuck
+        )
 
     def _leaving(self, position: Point, crossing: Crossing | None) -> bool:
         """Just out of the passage it held: it keeps it until its body is clear of the
