@@ -57,7 +57,8 @@ class Intent:
     distance to it (0 inside); ``entry`` the mouth it comes in by (None: it was inside
     when it asked); ``exit`` the mouth it leaves by (None: it stops inside);
     ``stalled`` is true when it has made no progress for its progress window;
-    ``waits_for`` names the AGVs it waits for (phase ``wait``).
+    ``waits_for`` names the AGVs it waits for (phase ``wait``); ``hold`` is the waiting
+    place [x, y] it is held at (empty: none).
     """
 
     name: str
@@ -71,6 +72,7 @@ class Intent:
     route: list[list[float]] = field(default_factory=list)
     waits_for: list[str] = field(default_factory=list)
     entry: int | None = None
+    hold: list[float] = field(default_factory=list)
 
 
 def holders(passage: int, intents: list[Intent]) -> list[Intent]:

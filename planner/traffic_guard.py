@@ -8,7 +8,10 @@ Not allowed: the AGV holds at a *waiting place* ``WAIT_BACK`` safety distances
 before the passage along its route, moved off the route to its right where the
 costmap has room, so that AGVs coming out of the passage pass it; each AGV queued
 before it on its side puts it ``QUEUE_GAP`` further back, and it moves up as they go
-in. While it waits and a holder of the passage reports no progress (a body in its way),
+in. No place lies within a safety distance of another AGV's waiting place (the intents
+carry them; of two sent to one place, the one that asked later chooses again), and of
+the places with room, one the AGV drives to straight past no waiting AGV comes first.
+While it waits and a holder of the passage reports no progress (a body in its way),
 an AGV in that holder's way moves one queue place back, off that holder's way: it
 yields. Once it waits or is let in, its claim reaches twice the request distance, so
 that neither a place far down the queue nor the route planned from there drops it.
@@ -119,7 +122,9 @@ class TrafficGuard:
             return self._decision(Intent(name, tick, CLEAR, stalled=stalled, route=shared))
         radius = self.costmap.clearance.radius  # only a claim chooses places: not when clear
         self._waiting = [
-            (*i.route[0], radius) for i in intents if i.name != name and i.phase in HELD and i.route
+            (*_held_at(i), radius)
+            for i in intents
+            if i.name != name and i.phase in HELD and i.route
         ]
         claim = (crossing.passage, crossing.exit)
         if claim != self._claim:
@@ -164,13 +169,21 @@ class TrafficGuard:
         if self._hold is not None and self._phase == WAIT and ahead < self._ahead:
             self._hold = None  # the queue moved up: so does its waiting place (it stayed
             # behind, and the next AGV to queue was sent to where it stood)
+        if self._hold is not None and self._taken(intent, intents):
+            self._hold = None
         if self._hold is None:
             self._ahead = ahead
-            self._hold = self._waiting_place(route, along + crossing.enter_at, ahead, keep_off)
+            self._hold = self._waiting_place(
+                route, along + crossing.enter_at, ahead, keep_off, position
+            )
         stuck = stuck_holders(crossing.passage, intents)
         if self._phase not in (YIELD, BACK) and self._in_way_of(stuck, position):
             self._hold = self._waiting_place(
-                route, along + crossing.enter_at, self._ahead + 1, [h.route for h in stuck]
+                route,
+                along + crossing.enter_at,
+                self._ahead + 1,
+                [h.route for h in stuck],
+                position,
             )  # one place further back in the queue, off the stuck holder's way
             intent.phase = self._phase = YIELD
         elif self._phase not in (YIELD, BACK):
@@ -185,6 +198,28 @@ class TrafficGuard:
         passage unclaimed, to ask again last (door n12 s3: the worst AGV drove 2.61 times
         its route, looping through the right-hand room)."""
         return self.request_distance * (2.0 if self._phase in (WAIT, YIELD, GO) else 1.0)
+
+    def _taken(self, me: Intent, intents: list[Intent]) -> bool:
+        """Whether an AGV held before this one (``since``, then name) waits at a place within
+        a safety distance of this one's. Two AGVs that ask in the same tick choose their
+        places without seeing each other's; the later one chooses again, the earlier one
+        keeps its place (door n12 s3: R5 circled the place R4 stood on for 10 s)."""
+        safety = self.costmap.clearance.safety_distance
+        radius = self.costmap.clearance.radius
+        return any(
+            math.dist(self._hold, _held_at(i)) - radius < safety
+            for i in intents
+            if i.phase in HELD and i.hold and (i.since, i.name) < (me.since, me.name)
+        )
+
+    def _clear_way(self, position: Point, place: Point) -> bool:
+        """Whether the straight way from ``position`` to ``place`` passes no waiting AGV
+        by less than both radii and half a safety distance (door n12 s3: R1, moving up
+        the queue, drove round R2 waiting between it and its new place: a loop)."""
+        margin = self.costmap.clearance.radius + self.costmap.clearance.safety_distance / 2
+        return all(
+            distance_to_path([position, place], (x, y)) >= r + margin for x, y, r in self._waiting
+        )
 
     def _in_way_of(self, stuck: list[Intent], position: Point) -> bool:
         """Whether this AGV, or its waiting place, is ``IN_WAY`` of the way ahead of a stuck
@@ -218,19 +253,22 @@ class TrafficGuard:
         if intent.phase not in HELD:
             self._hold = None
         intent.waits_for = sorted(blockers)
+        intent.hold = [] if hold is None else [round(hold[0], 2), round(hold[1], 2)]
         return TrafficDecision(intent, hold, rejoin)
 
     def _waiting_place(
-        self, route: list[Point], enter_at: float, ahead: int = 0, keep_off=()
+        self, route: list[Point], enter_at: float, ahead: int = 0, keep_off=(), start=None
     ) -> Point:
         """``WAIT_BACK`` before the passage (``enter_at`` m along the route), and
         ``QUEUE_GAP`` further for each of the ``ahead`` AGVs queued before it on its side
         (a crowd at the mouth blocks the AGVs coming out), moved to the right of the
         route where free, and off the routes ``keep_off`` (the holders' routes ahead); where
         no place with room is clear of them, the one furthest off them (falling back to the
-        route itself put an AGV waiting in a 1.5 m corridor's mouth on the holder's way)."""
+        route itself put an AGV waiting in a 1.5 m corridor's mouth on the holder's way).
+        Places the AGV drives to from ``start`` past no waiting AGV come first."""
         safety = self.costmap.clearance.safety_distance
         furthest, best = -math.inf, None  # the place with room furthest off the holders' way
+        clear = []  # the places with room off the holders' way
         for back in WAIT_BACK:
             back += ahead * QUEUE_GAP
             point, heading = _point_along(route, max(0.0, enter_at - back * safety))
@@ -241,9 +279,13 @@ class TrafficGuard:
                     continue
                 off = min((distance_to_path(r, place) for r in keep_off), default=math.inf)
                 if off >= IN_WAY * safety:
-                    return place
+                    if start is None or self._clear_way(start, place):
+                        return place
+                    clear.append(place)
                 if off > furthest:
                     furthest, best = off, place
+        if clear:
+            return clear[0]
         if best is not None:  # none clear of the holders' way: the least in it, not the route
             return best
         return _point_along(route, max(0.0, enter_at - WAIT_BACK[0] * safety))[0]
@@ -297,6 +339,11 @@ def _point_along(route: list[Point], at: float) -> tuple[Point, float]:
         travelled += length
     a, b = route[-2] if len(route) > 1 else route[0], route[-1]
     return tuple(b), math.atan2(b[1] - a[1], b[0] - a[0])
+
+
+def _held_at(intent: Intent) -> Point:
+    """Where a held AGV waits: its waiting place, or where it is when it shares none."""
+    return tuple(intent.hold) if intent.hold else tuple(intent.route[0])
 
 
 def _ahead_on_my_side(me: Intent, intents: list[Intent]) -> int:

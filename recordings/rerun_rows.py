@@ -26,6 +26,8 @@ Entity paths (everything on the map under ``world``, in world coordinates):
     world/agv/<name>/dwa          LineStrips2D: DWA's chosen trajectory (cleared on arrival)
     world/agv/<name>/waiting      Points2D: a ring round an AGV the traffic rule holds, labelled
                                   with whom it waits for (cleared when it goes)
+    world/agv/<name>/waiting/place  LineStrips2D: from that AGV to the waiting place the rule
+                                  sent it to (cleared when it goes)
     events/<kind>                 TextLog: one entity per kind of event (the world's events:
                                   arrived, failed, collision, end, wait, go, yield, ...; and
                                   from the plans: replan, no path)
@@ -261,20 +263,24 @@ class RowMaker:
     def _waiting(self, t: float, data: dict, rows: list[Row]) -> None:
         """A ring round each AGV the traffic rule holds, labelled with whom it waits for."""
         held = {
-            i["name"]: i.get("waits_for", [])
+            i["name"]: i
             for i in data.get("intents", [])  # none in recordings before the traffic rule
             if i["phase"] in HELD
         }
         for s in data["agvs"]:
             name = s["name"]
             if name in held:
-                label = "waits for " + (", ".join(held[name]) or "its turn")
+                label = "waits for " + (", ".join(held[name].get("waits_for", [])) or "its turn")
                 ring = ([[s["x"], s["y"]]], [WAITING_RING * s["radius"]], [label])
                 rows.append(Row(agv_path(name, "waiting"), kinds.points, t, ring))
+                hold = held[name].get("hold", [])  # none in recordings before it was shared
+                way = [[[s["x"], s["y"]], hold]] if hold else []
+                rows.append(Row(agv_path(name, "waiting/place"), kinds.strips, t, way))
                 self._waiting_shown.add(name)
             elif name in self._waiting_shown:
                 self._waiting_shown.discard(name)
                 rows.append(Row(agv_path(name, "waiting"), kinds.points, t, ([], [], [])))
+                rows.append(Row(agv_path(name, "waiting/place"), kinds.strips, t, []))
 
     def _state(self, name: str, data: dict, rows: list[Row]) -> None:
         t = self._time(data["tick"])

@@ -19,6 +19,7 @@ from planner.costmap import Costmap
 from planner.dwa import DwaConfig
 from planner.map_io import parse_text_grid
 from planner.passages import NONE, Passages
+from planner.path_metrics import distance_to_path
 from planner.traffic import (
     BACK,
     CLEAR,
@@ -169,6 +170,45 @@ def test_no_waiting_place_within_a_safety_distance_of_another_waiting_agv():
     assert math.dist(waits.hold, alone.hold) - WIDE.radius >= safety
 
 
+def test_of_two_agvs_sent_to_one_waiting_place_the_later_chooses_again():
+    """Two AGVs that ask in the same tick choose their places without seeing each other's
+    and can choose the same one (door n12 s3: R5 circled R4 standing on its place for
+    10 s). The intents share the places; the AGV that asked later moves, the earlier
+    one keeps its place."""
+    kept = {}
+    for other, since in (("w", 0), ("y", 1)):  # before x (since 0), after x (since 1, "y")
+        guard, waits, holder = _waiting_east_of_a_holder()
+        assert waits.intent.hold == [round(v, 2) for v in waits.hold]
+        there = Intent(
+            other, 2, WAIT, waits.intent.passage, waits.intent.exit, since,
+            route=[[1.0, 1.0]], hold=list(waits.hold),  # still on its way there
+        )  # fmt: skip
+        fleet = [holder, waits.intent, there]
+        kept[other] = guard.decide("x", 3, (4.5, MID), EASTWARD, fleet, stalled=False).hold
+        assert kept[other] is not None
+    safety = WIDE.safety_distance
+    assert math.dist(kept["w"], waits.hold) - WIDE.radius >= safety
+    assert kept["y"] == waits.hold
+
+
+def test_a_waiting_place_is_one_the_agv_drives_to_past_no_waiting_agv():
+    """Sent to a place across an AGV waiting between, an AGV drove round it, a loop in a
+    crowded room (door n12 s3: R1 round R2). Of the places with room, one with a clear
+    straight way comes first."""
+    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
+    guard = TrafficGuard(costmap, DwaConfig(max_speed=1.0, max_accel=0.5))
+    west = guard.passages.first_crossing([(18.0, MID), (2.0, MID)], lookahead=30.0)
+    holder = Intent("h", 1, GO, west.passage, west.exit, 0, route=[[10.0, MID], [2.0, MID]])
+    between = (4.25, MID)  # held for another passage, on x's route
+    other = Intent("w", 1, WAIT, west.passage + 1, 0, 0, route=[list(between)], hold=[*between])
+    asked = guard.decide("x", 1, (2.0, MID), EASTWARD, [holder, other], stalled=False)
+    fleet = [holder, other, asked.intent]
+    waits = guard.decide("x", 2, (2.0, MID), EASTWARD, fleet, stalled=False)
+    assert waits.intent.phase == WAIT
+    passing = distance_to_path([(2.0, MID), waits.hold], between)
+    assert passing >= 2 * WIDE.radius + WIDE.safety_distance / 2
+
+
 def test_only_an_agv_in_a_stuck_holders_way_yields_further_back():
     """Every waiting AGV yielding for any stuck holder churned the crowd at a 1.0 m door
     (traffic_bench door n12 s3: waiting AGVs looped through the rooms, up to 3.7 times
@@ -313,6 +353,10 @@ def test_the_recording_and_rerun_show_who_waits_where_and_the_passages(tmp_path)
     rings = [r for r in shown["/world/agv/b/waiting"].rows if r[1]["Points2D:positions"]]
     assert len(rings) == len(held)
     assert all(r[1]["Points2D:labels"] == ["waits for a"] for r in rings)
+    places = [r for r in shown["/world/agv/b/waiting/place"].rows if r[1]["LineStrips2D:strips"]]
+    assert len(places) == len(held)  # a line from b to where it was sent, while it waits
+    last_hold = next(i["hold"] for i in held[-1]["intents"] if i["name"] == "b")
+    assert places[-1][1]["LineStrips2D:strips"][0][-1] == pytest.approx(last_hold)
     assert "/world/agv/a/waiting" not in shown or not any(
         r[1]["Points2D:positions"] for r in shown["/world/agv/a/waiting"].rows
     )
@@ -368,3 +412,6 @@ def test_the_world_refuses_an_intent_from_a_later_tick():
     honest = Intent("a", 0, REQUEST, 0, exit=1, since=1)
     world.advance({"a": AgvCommand("a", 2, 0.0, 0.0, 0.0, intent=honest)})
     assert world.intents["a"].phase == REQUEST
+    malformed = Intent("a", 0, WAIT, 0, exit=1, since=1, hold=[1.0, 2.0, 3.0])
+    world.advance({"a": AgvCommand("a", 3, 0.0, 0.0, 0.0, intent=malformed)})
+    assert "a" not in world.intents and world.records["a"].refused == 2

@@ -154,7 +154,11 @@ class World:
         if status in FINISHED or intent is None or intent.name != name:
             self.intents.pop(name, None)
             return
-        if intent.since > self.tick or any(len(p) != 2 for p in intent.route):
+        if (
+            intent.since > self.tick
+            or any(len(p) != 2 for p in intent.route)
+            or len(intent.hold) not in (0, 2)
+        ):
             self._refuse(name, "a traffic intent asked in a later tick or with malformed points")
             self.intents.pop(name, None)
             return
