@@ -76,7 +76,13 @@ CALM_WINDOWS = 3
 """Progress windows without a stall after which the recoveries start again from the first."""
 
 BEHIND = math.radians(120.0)
-"""A target this far off the body's heading is behind it: turn round on the spot first."""
+"""A target this far off the body's heading is behind it: turn round on the spot first ..."""
+FACED = math.radians(30.0)
+"""... and to a waiting place, until it is this near the heading. Handing over to DWA at
+``BEHIND`` left it 120° off, and DWA's arc to it from there is a loop (door n10 s4: L5,
+sent from one waiting place to another behind it, looped in the crowded room). Not for
+route targets: a longer turn there set the progress checker's recoveries off at tight
+corners (nav_bench seed 4 failed)."""
 
 PARKED_ROUNDS = 3
 """How many times a recovery replan goes round the discs parked on the plan it drew."""
@@ -173,6 +179,7 @@ class FusionController:
         self._best_remaining = math.inf
         self._best_time = 0.0
         self._turning = False
+        self._rounding = False  # turning round on the spot to a waiting place (``FACED``)
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
         self._recoveries_done = 0
@@ -359,7 +366,7 @@ class FusionController:
         position = (pose[0], pose[1])
         if math.dist(position, hold) <= self.config.goal_tolerance:  # there: stand
             return _step(braking_command(self.config.dwa, command), WAITING, hold, plan=plan)
-        turn = self._turn_round(pose, command, hold, moving)  # behind: turn, do not circle
+        turn = self._turn_round(pose, command, hold, moving, FACED)  # behind: turn, no circle
         if turn is not None:
             return _step(turn, WAITING, hold, plan=plan)
         straight = self._straight_to(pose, command, hold, moving, walkers)
@@ -433,25 +440,30 @@ class FusionController:
         self._best_time = now  # turning on the spot is progress for the progress checker
         return _step(cmd, "driving", first)
 
-    def _turn_round(self, pose, command, target, moving) -> tuple[float, float, float] | None:
+    def _turn_round(
+        self, pose, command, target, moving, faced: float = BEHIND
+    ) -> tuple[float, float, float] | None:
         """Default profile, an AGV that cannot reverse and a target behind it: the turn on
         the spot towards it (DWA's arcs only circle, turning the body while driving on),
         unless a walker is coming; None otherwise. An AGV too fast to stop within its
         clearance brakes straight first: turning while it braked from lane speed swept an
         arc into a wall (a replan at 1.2 m/s that sent the route back the way it came),
         while the way straight ahead is the old route's, clear at least to what made it
-        replan."""
+        replan. Once turning, it turns on until the target is ``faced`` off the heading."""
         if not self.behaviour.turn_round or self.config.dwa.min_vx < 0:
             return None
         bearing = math.atan2(target[1] - pose[1], target[0] - pose[0])
         error = float(wrap_angle(bearing - pose[2]))
-        if abs(error) <= BEHIND or self.dwa.threatened(pose, moving):
+        if abs(error) <= (faced if self._rounding else BEHIND) or self.dwa.threatened(pose, moving):
+            self._rounding = False
             return None
         cfg = self.config.dwa
         stopping = math.hypot(command[0], command[1]) ** 2 / (2.0 * cfg.max_accel)
         if stopping > self.dwa.distance_field.distance_at(pose[0], pose[1]) - cfg.radius:
             return braking_command(cfg, command)
-        return turn_command(cfg, error, command)
+        turn = turn_command(cfg, error, command)
+        self._rounding = turn is not None
+        return turn
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
         """The command and predicted path of the straight approach to a tight corner, when

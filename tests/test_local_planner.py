@@ -394,6 +394,24 @@ def test_a_waiting_place_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_s
     assert out.command[1] == 0.0 and out.command[2] != 0.0  # braking and turning
 
 
+def test_a_turn_round_to_a_place_behind_goes_on_until_it_nearly_faces_it():
+    # handed to DWA at 120° off, the AGV drove an arc to it from there: a loop in a
+    # crowded room (traffic_bench door n10 s4: L5 sent from one waiting place to another)
+    grid = parse_text_grid("\n".join(["." * 30] * 5))
+    controller = FusionController(grid, (28.5, 2.5), FusionConfig())
+    pose, command = (20.5, 2.5, 0.0), (0.0, 0.0, 0.0)
+    controller.start(pose)
+    controller.step(pose, command, 0.0)
+    hold = (10.5, 2.5)  # straight behind, beyond the straight approach's reach
+    for k in range(1, 300):
+        command = controller.step(pose, command, 0.1 * k, hold=hold).command
+        if math.hypot(command[0], command[1]) > 0:  # it sets off
+            break
+        pose = (pose[0], pose[1], pose[2] + command[2] * 0.1)  # turning on the spot
+    bearing = math.atan2(hold[1] - pose[1], hold[0] - pose[0])
+    assert abs(math.remainder(bearing - pose[2], math.tau)) <= math.radians(35)
+
+
 def _fails_at(moving: np.ndarray, walkers: np.ndarray) -> float:
     """When a controller held in place (its commands never move it) on an open floor gives
     up, with ``moving`` standing 1 m beside it."""
