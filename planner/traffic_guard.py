@@ -204,13 +204,13 @@ class TrafficGuard:
         a safety distance of this one's. Two AGVs that ask in the same tick choose their
         places without seeing each other's; the later one chooses again, the earlier one
         keeps its place (door n12 s3: R5 circled the place R4 stood on for 10 s)."""
-        safety = self.costmap.clearance.safety_distance
         radius = self.costmap.clearance.radius
-        return any(
-            math.dist(self._hold, _held_at(i)) - radius < safety
+        before = [
+            (*_held_at(i), radius)
             for i in intents
             if i.phase in HELD and i.hold and (i.since, i.name) < (me.since, me.name)
-        )
+        ]
+        return self._crowded(self._hold, before)
 
     def _clear_way(self, position: Point, place: Point) -> bool:
         """Whether the straight way from ``position`` to ``place`` passes no waiting AGV
@@ -319,12 +319,15 @@ class TrafficGuard:
         cell = grid.cell_of(point)
         if not grid.contains_cell(cell) or self.passages.label[cell[1], cell[0]] >= 0:
             return False
-        safety = self.costmap.clearance.safety_distance
-        if any(
-            math.dist(point, (x, y)) - r < safety for x, y, r in (*self._parked, *self._waiting)
-        ):
+        if self._crowded(point, [*self._parked, *self._waiting]):
             return False
-        return self.costmap.distance[cell[1], cell[0]] >= safety
+        return self.costmap.distance[cell[1], cell[0]] >= self.costmap.clearance.safety_distance
+
+    def _crowded(self, point: Point, discs) -> bool:
+        """Whether a place lies within a safety distance of any of the (x, y, radius)
+        ``discs`` (AGVs parked, or held at their waiting places)."""
+        safety = self.costmap.clearance.safety_distance
+        return any(math.dist(point, (x, y)) - r < safety for x, y, r in discs)
 
 
 def _point_along(route: list[Point], at: float) -> tuple[Point, float]:
