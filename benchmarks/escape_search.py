@@ -65,7 +65,7 @@ def search(episode, start, when: float, accel: float, rotate: float, horizon: fl
     for k in range(1, round(horizon / STEP) + 1):
         new_vel = (vel[:, None, :] + controls[None] * STEP).reshape(-1, 2)
         new_pos = np.repeat(pos, len(controls), axis=0) + new_vel * STEP
-        gap = np.array([float(field.distance_at(px, py)) for px, py in new_pos]) - radius
+        gap = field.distance_at(new_pos[:, 0], new_pos[:, 1]) - radius
         for walker in episode.moving:
             wx, wy, _, _ = walker.state_at(when + k * STEP)
             gap = np.minimum(gap, np.hypot(new_pos[:, 0] - wx, new_pos[:, 1] - wy)

@@ -120,12 +120,10 @@ class TrafficGuard:
         if crossing is None:
             self._claim, self._phase = None, CLEAR
             return self._decision(Intent(name, tick, CLEAR, stalled=stalled, route=shared))
-        radius = self.costmap.clearance.radius  # only a claim chooses places: not when clear
-        self._waiting = [
-            (*_held_at(i), radius)
-            for i in intents
-            if i.name != name and i.phase in HELD and i.route
-        ]
+        # only a claim chooses places: not when clear
+        self._waiting = self._discs(
+            i for i in intents if i.name != name and i.phase in HELD and i.route
+        )
         claim = (crossing.passage, crossing.exit)
         if claim != self._claim:
             self._claim, self._since, self._phase, self._hold = claim, tick, REQUEST, None
@@ -204,13 +202,16 @@ class TrafficGuard:
         a safety distance of this one's. Two AGVs that ask in the same tick choose their
         places without seeing each other's; the later one chooses again, the earlier one
         keeps its place (door n12 s3: R5 circled the place R4 stood on for 10 s)."""
-        radius = self.costmap.clearance.radius
-        before = [
-            (*_held_at(i), radius)
-            for i in intents
+        before = self._discs(
+            i for i in intents
             if i.phase in HELD and i.hold and (i.since, i.name) < (me.since, me.name)
-        ]
+        )  # fmt: skip
         return self._crowded(self._hold, before)
+
+    def _discs(self, held) -> list[tuple[float, float, float]]:
+        """(x, y, radius) of each held AGV's waiting place (``_held_at``)."""
+        radius = self.costmap.clearance.radius
+        return [(*_held_at(i), radius) for i in held]
 
     def _clear_way(self, position: Point, place: Point) -> bool:
         """Whether the straight way from ``position`` to ``place`` passes no waiting AGV
