@@ -29,7 +29,8 @@ nearby); a final approach scored by nearness to the goal;
 arrival only when stopped inside the tolerance; bounded recoveries
 (``planner/recovery.py``), whose replans go round discs parked on the route,
 and then ``failed`` with the reason; a turn on the spot towards a target
-behind; early yielding to walkers (``planner/yielding.py``, in DWA).
+behind; a key node gone by beside it switched from when the next is in plain sight
+(``planner/passed_node.py``); early yielding to walkers (``planner/yielding.py``, in DWA).
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ from planner.keep_right import agv_coming, right_offset, shifted_right
 from planner.lane_speed import oncoming, route_room
 from planner.local_behaviour import local_behaviour
 from planner.parked_discs import blocking_cells
+from planner.passed_node import in_plain_sight, passed_beside
 from planner.path_metrics import distance_to_path
 from planner.profiles import DEFAULT, check_profile
 from planner.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, recovery_command
@@ -602,7 +604,7 @@ class FusionController:
             if corner.stop:
                 straight = self._straight_to(pose, command, node, moving, walkers)
             if straight is None:
-                if distance > self._dwa_reach():
+                if distance > self._dwa_reach() and not self._passed_beside(pose, corner):
                     return None
             elif distance > corner.reach or not stopped_enough(self.config.dwa, command):
                 return straight  # not there, or not stopped yet
@@ -611,6 +613,20 @@ class FusionController:
                 self._turning = True  # turn_command brakes omega, then turns
                 return None
         return None
+
+    def _passed_beside(self, pose, corner: Corner) -> bool:
+        """Default profile: the AGV went past the current key node beside it, beyond its
+        reach, and sees the next one in plain sight (``planner.passed_node``): it switches
+        on instead of turning back to the node. Not at a stop corner (a narrow stretch
+        follows: it is entered from the node)."""
+        if not self.behaviour.pass_beside or corner.stop:
+            return False
+        position = (pose[0], pose[1])
+        node, after = self.targets[self.target_index], self.targets[self.target_index + 1]
+        if not passed_beside(position, self._segment_start(), node, after, corner.reach):
+            return False
+        field = self.dwa.distance_field
+        return in_plain_sight(field, position, after, self.config.safety_distance)
 
     def _dwa_reach(self) -> float:
         """How near DWA must come to the current key node to switch to the next: the

@@ -25,6 +25,7 @@ class LocalBehaviour:
     yield_early: bool  # keep to trajectories that leave the AGV off the walkers' way
     turn_round: bool  # a target behind an AGV that cannot reverse: turn on the spot first
     tight_turns: bool  # switch late, or stop and turn, where the route turns into a narrow stretch
+    pass_beside: bool  # a key node gone past beside, the next in plain sight: switch on, not back
     lane_speed: bool  # on the route: speed bounded by the room to brake ahead, not beside
     keep_right: bool  # another AGV coming the other way: follow the route shifted right
     route_weight: float  # weight of the term keeping trajectories on the global route
@@ -48,6 +49,7 @@ def local_behaviour(profile: str, *, free_heading: bool = False) -> LocalBehavio
         yield_early=on,
         turn_round=on,
         tight_turns=on,
+        pass_beside=on,
         lane_speed=on,
         keep_right=on,
         route_weight=0.3 if on else 0.0,
