@@ -20,7 +20,7 @@ import math
 
 from planner.distance_field import DistanceField
 from planner.grid_map import Point
-from planner.route_check import route_samples
+from planner.route_check import blocked_point
 
 
 def passed_beside(position: Point, before: Point, node: Point, after: Point, reach: float) -> bool:
@@ -40,5 +40,4 @@ def passed_beside(position: Point, before: Point, node: Point, after: Point, rea
 def in_plain_sight(field: DistanceField, position: Point, target: Point, safety: float) -> bool:
     """Whether the straight way from ``position`` to ``target`` keeps ``safety`` m from every
     obstacle."""
-    points = route_samples([position, target], field.spacing / 2)
-    return bool(field.distance_at(points[:, 0], points[:, 1]).min() >= safety)
+    return blocked_point(field, [position, target], safety) is None
