@@ -27,6 +27,7 @@ from benchmarks.nav_episodes import make_episode
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process
 from planner.distance_field import DistanceField
+from planner.motion import world_velocity
 
 STEP = 0.1  # s
 
@@ -38,16 +39,17 @@ class _Reached(Exception):
 def state_at(episode, when: float):
     """(x, y, vx, vy) of the AGV in the world frame at sim time ``when``."""
     found = {}
+    scenario = episode.scenario("fusion", "default")
 
     def sink(key, msg):
         if key == keys.WORLD_TICK and msg.time >= when - 1e-9:
             a = msg.agvs[0]
-            c, s = math.cos(a.theta), math.sin(a.theta)
-            found["state"] = (a.x, a.y, a.vx * c - a.vy * s, a.vx * s + a.vy * c, a.radius)
+            vx, vy = world_velocity(a.theta, a.vx, a.vy, a.omega, scenario.dt)
+            found["state"] = (a.x, a.y, float(vx), float(vy), a.radius)
             raise _Reached
 
     try:
-        run_in_process(episode.scenario("fusion", "default"), sink)
+        run_in_process(scenario, sink)
     except _Reached:
         return found["state"]
     raise SystemExit(f"escape_search: the run ended before {when} s")
