@@ -42,7 +42,8 @@ and it picks, among the samples scoring near the best, the one that changes
 the last cycle's acceleration least (``steady_choice``), so the chosen
 acceleration stops flipping every cycle. Along the route it bounds the linear
 speed by the room to brake along the path rather than the clearance beside it
-(``planner.lane_speed``).
+(``planner.lane_speed``). While another AGV can lower a sample's clearance, the
+samples that drive away from the target are dropped (``planner.no_retreat``).
 
 Beyond the paper, for arriving (at 0.2 m/s² an AGV at 2 m/s needs 10 m to
 stop, and a 3 s rollout's end lies past a nearby target, so plain DWA circles
@@ -65,7 +66,14 @@ from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index
 from planner.lane_speed import ROUTE_TOLERANCE, braking_room, node_room, stop_room
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
-from planner.yielding import YIELD_SLACK, parked_clearance, walker_near, yield_horizon
+from planner.no_retreat import retreating
+from planner.yielding import (
+    YIELD_SLACK,
+    agvs_of,
+    parked_clearance,
+    walker_near,
+    yield_horizon,
+)
 
 Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
@@ -568,6 +576,8 @@ class DwaPlanner:
                 braking = lower_by_discs(xs, ys, braking, near, cfg.dt, cfg.radius)
             braking = np.maximum(braking, clearance)
         mask = admissible_mask(cfg, commands, clearance, braking)
+        if self.behaviour.no_retreat and len(agvs_of(lowering, walkers)):
+            mask &= ~retreating(pose, xs[:, -1], ys[:, -1], target_xy)
         if self.behaviour.yield_early and walkers is not None and len(walkers):
             ends = (xs[:, -1], ys[:, -1])
             walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)

@@ -66,7 +66,7 @@ from planner.tight_turns import (
     stopped_enough,
 )
 from planner.turning import turn_command
-from planner.yielding import walker_near
+from planner.yielding import agvs_of, walker_near
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
@@ -420,7 +420,7 @@ class FusionController:
         if not self.behaviour.keep_right:
             return segment
         field, radius = self.dwa.distance_field, self.config.dwa.radius
-        if not agv_coming(pose[:2], segment, radius, _agvs_of(moving, walkers)):
+        if not agv_coming(pose[:2], segment, radius, agvs_of(moving, walkers)):
             return segment
         return shifted_right(segment, right_offset(field, radius, segment))
 
@@ -651,20 +651,7 @@ class FusionController:
         return now - self._best_time >= self.config.progress_window
 
 
-def _agvs_of(moving, walkers) -> np.ndarray:
-    """The rows of ``moving`` that are not walkers (``walkers`` are rows of it too): the
-    other AGVs."""
-    if moving is None or not len(moving):
-        return np.zeros((0, 5))
-    moving = np.asarray(moving, dtype=float).reshape(-1, 5)
-    if walkers is None or not len(walkers):
-        return moving
-    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
-    is_walker = (moving[:, None, :] == walkers[None, :, :]).all(axis=2).any(axis=1)
-    return moving[~is_walker]
-
-
 def _agv_near(position: Point, moving, walkers) -> bool:
     """Whether another AGV (a moving disc that is not a walker) is within ``JAM_RANGE``."""
-    agvs = _agvs_of(moving, walkers)
+    agvs = agvs_of(moving, walkers)
     return bool((np.hypot(agvs[:, 0] - position[0], agvs[:, 1] - position[1]) < JAM_RANGE).any())

@@ -28,6 +28,7 @@ class LocalBehaviour:
     pass_beside: bool  # a key node gone past beside, the next in plain sight: switch on, not back
     lane_speed: bool  # on the route: speed bounded by the room to brake ahead, not beside
     keep_right: bool  # another AGV coming the other way: follow the route shifted right
+    no_retreat: bool  # another AGV in reach: brake or step aside, never drive off the target
     route_weight: float  # weight of the term keeping trajectories on the global route
     face_travel_weight: float  # weight of the term facing the body along its travel
     steady_tolerance: float  # keep the acceleration unless this near the best (score spread)
@@ -52,6 +53,7 @@ def local_behaviour(profile: str, *, free_heading: bool = False) -> LocalBehavio
         pass_beside=on,
         lane_speed=on,
         keep_right=on,
+        no_retreat=on,
         route_weight=0.3 if on else 0.0,
         face_travel_weight=0.3 if on and not free_heading else 0.0,
         steady_tolerance=STEADY_TOLERANCE if on else 0.0,

@@ -140,3 +140,16 @@ def walker_near(pose, walkers) -> bool:
         return False
     walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
     return bool((np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE).any())
+
+
+def agvs_of(moving, walkers) -> np.ndarray:
+    """The rows of ``moving`` that are not walkers (``walkers`` are rows of it too): the
+    other AGVs."""
+    if moving is None or not len(moving):
+        return np.zeros((0, 5))
+    moving = np.asarray(moving, dtype=float).reshape(-1, 5)
+    if walkers is None or not len(walkers):
+        return moving
+    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+    is_walker = (moving[:, None, :] == walkers[None, :, :]).all(axis=2).any(axis=1)
+    return moving[~is_walker]

@@ -1,0 +1,40 @@
+"""Never drive away from the target to make room for another AGV (default profile).
+
+DWA treats another AGV as a disc moving on at its velocity. Against a disc
+coming its way, the samples that keep the most clearance over the horizon are
+those that run ahead of it: an AGV met head-on in a 2 m aisle turned and drove
+off with the other behind it, circled back, met the next one and circled again
+(traffic suite warehouse-40 n40 s0: agv9 circled in the cross aisle for 40 s,
+18 self-crossings of its path); in a corridor an AGV backed out metres ahead of
+an oncoming pair. The other AGV plans too: one that brakes or steps aside is
+predictable to it, one that flees keeps it coming. So while another AGV can
+lower a sample's clearance, the samples whose displacement over the horizon
+points away from the target by more than ``RETREAT_ANGLE`` are dropped; with
+nothing else admissible the AGV brakes (as DWA does when only AGVs are in reach,
+``DwaPlanner._evade_from``). Walkers do not plan: from them the AGV still backs
+off (``planner.yielding``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+RETREAT_ANGLE = math.radians(100.0)
+"""rad: a displacement further than this from the direction to the target drives away
+from it (a step straight aside, 90 degrees, is not a retreat)."""
+
+STANDING = 0.1
+"""m: a displacement over the horizon shorter than this (braking, turning on the spot) is
+no retreat."""
+
+
+def retreating(pose, end_x: np.ndarray, end_y: np.ndarray, target) -> np.ndarray:
+    """(N,) whether each sample, from ``pose`` to its end point (``end_x``, ``end_y``),
+    drives away from ``target``."""
+    dx, dy = end_x - pose[0], end_y - pose[1]
+    tx, ty = target[0] - pose[0], target[1] - pose[1]
+    shift = np.hypot(dx, dy)
+    towards = dx * tx + dy * ty
+    return (shift > STANDING) & (towards < math.cos(RETREAT_ANGLE) * shift * math.hypot(tx, ty))
