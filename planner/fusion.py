@@ -345,7 +345,7 @@ class FusionController:
         )
         turn = self._turn_round(pose, command, target, moving)
         if turn is not None:
-            return _step(turn, "driving", target)
+            return _step(turn, "driving", target, plan=plan)
         if straight is not None:  # the last metres to a tight corner or the goal, straight
             return _step(straight[0], "driving", target, straight[1], plan)
         reach = self.config.goal_tolerance if final else self._dwa_reach()

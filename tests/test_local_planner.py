@@ -371,6 +371,20 @@ def test_a_target_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
     assert speeds["paper"] > 0.3  # DWA's arcs speed up, circling
 
 
+def test_a_replan_that_starts_with_a_turn_round_is_still_published():
+    # warehouse-10 n10 s2: agv4's replan round an AGV parked in its aisle began with a turn
+    # on the spot, and the step dropped the plan: the recording never showed the new route
+    grid = parse_text_grid("\n".join(["............", ".##########.", "............"]), 1.0)
+    controller = FusionController(grid, (10.5, 0.5), FusionConfig())
+    controller.start((5.5, 0.5, 0.0))
+    controller.park([(8.5, 0.5, 0.3)])  # stopped for good on the way: round the loop
+    steps = [controller.step((5.5, 0.5, 0.0), (0.0, 0.0, 0.0), 0.1 * k) for k in range(3)]
+    replans = [s for s in steps if s.plan is not None]
+    assert len(replans) == 1
+    assert replans[0].plan.key_nodes[1] == pytest.approx((0.5, 0.5))  # behind the AGV
+    assert replans[0].command[:2] == (0.0, 0.0) and replans[0].command[2] != 0.0
+
+
 def test_backing_off_moves_away_from_a_standing_walker_not_only_from_the_walls():
     # a wall 0.5 m south, a walker standing 0.7 m north: away from the walls alone is
     # straight into the walker (nav_bench seed 55 backed into one in its recoveries)
