@@ -64,7 +64,9 @@ def outcome(summary: RunSummary) -> dict:
         "end_reason": summary.end_reason,
         "sim_time": round(summary.sim_time, 6),
         "collisions": summary.collisions,
-        "agvs": {a.name: [a.status, a.arrival_time, a.collisions] for a in summary.agvs},
+        "agvs": {
+            a.name: [a.status, a.arrival_time, a.collisions, a.self_crossings] for a in summary.agvs
+        },
     }
 
 
@@ -108,6 +110,7 @@ def run_case(family: str, seed: int) -> dict:
             a.name: round(a.distance / a.route_length, 3) for a in summary.agvs if a.route_length
         },
         "statuses": {a.name: a.status for a in summary.agvs},
+        "self_crossings": {a.name: a.self_crossings for a in summary.agvs if a.self_crossings},
         "failures": {a.name: a.failure for a in summary.agvs if a.failure},
         "outcome": outcome(summary),
         "wall_s": round(wall, 2),
@@ -160,6 +163,7 @@ def family_rows(results: list[dict]) -> list[dict]:
                 "max_wait_s": max(waits) if waits else None,
                 "worst_driven_over_route": max(detours) if detours else None,
                 "agvs_over_detour": sum(d > DETOUR for d in detours),
+                "loops": sum(n for r in runs for n in r["self_crossings"].values()),
                 "solo_failures": sum(len(r["solo_failures"]) for r in runs),
                 "time_limit_s": [limits[0], limits[-1]],
             }
@@ -176,7 +180,7 @@ def print_table(rows: list[dict]) -> None:
         f"{'family':<18} {'runs':>4} {'AGVs':>4} {'arrived':>7} {'all':>3} {'failed':>6} "
         f"{'coll':>4} "
         f"{'limit':>5} {'mk/sum med':>10} {'mk/sum max':>10} {'mk/long med':>11} "
-        f"{'wait mean':>9} {'wait max':>8} {'drive max':>9} {f'>{DETOUR:g}x':>5} "
+        f"{'wait mean':>9} {'wait max':>8} {'drive max':>9} {f'>{DETOUR:g}x':>5} {'loops':>5} "
         f"{'solo fail':>9} {'time limit s':>12}"
     )
     print(header)
@@ -191,6 +195,7 @@ def print_table(rows: list[dict]) -> None:
             f"{_f(r['median_makespan_over_longest_solo'], '.2f'):>11} "
             f"{_f(r['mean_wait_s'], '.1f'):>9} {_f(r['max_wait_s'], '.1f'):>8} "
             f"{_f(r['worst_driven_over_route'], '.2f'):>9} {r['agvs_over_detour']:>5} "
+            f"{r['loops']:>5} "
             f"{r['solo_failures']:>9} {f'{lo:g}-{hi:g}':>12}"
         )
     print(
@@ -200,7 +205,8 @@ def print_table(rows: list[dict]) -> None:
         "solo run, runs where every AGV arrived only; wait: seconds per AGV held outside a\n"
         "passage by the traffic rule (status 'waiting'); drive max: the most an AGV drove over\n"
         f"the length of its first route (loops and detours show here); >{DETOUR:g}x: AGVs that\n"
-        "drove more than that; solo fail: AGVs that do not arrive alone."
+        "drove more than that; loops: times the AGVs' driven paths crossed themselves\n"
+        "(planner.path_metrics.self_crossings); solo fail: AGVs that do not arrive alone."
     )
 
 

@@ -1,7 +1,8 @@
 """Metrics of a polyline path, usable on any path (planned or driven).
 
 Turning times count the vertices where the heading changes; the total turning
-angle sums the absolute heading changes (the paper's Tables 2 and 3).
+angle sums the absolute heading changes (the paper's Tables 2 and 3). Self-crossings
+count an AGV's loops: a driven path that circles crosses its own track.
 """
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ from __future__ import annotations
 import itertools
 import math
 
+import numba
 import numpy as np
 
 # heading changes below this are numerical noise on a straight line, not turns
@@ -72,3 +74,53 @@ def distance_to_path(path, point) -> float:
     if len(path) == 1:
         best = math.dist(path[0], point)
     return best
+
+
+LOOP_GAP = 1.0
+"""m along the path: two stretches at least this far apart that cross make a loop; nearer
+ones are one manoeuvre (a turn on the spot, a wobble), not a loop."""
+
+LOOP_ANGLE = math.radians(30.0)
+"""rad: stretches crossing at less than this (or more than 180 degrees less this) retrace
+the track, forwards or back: their sampled segments cross by chance, many times."""
+
+
+def self_crossings(path, gap: float = LOOP_GAP) -> int:
+    """How often ``path`` crosses itself, between stretches at least ``gap`` apart along it
+    and at an angle of at least ``LOOP_ANGLE`` (a curl driven once crosses its own track
+    once; driving back along the same line, or round the same circle again, does not)."""
+    pts = _points(path)
+    if len(pts) < 4:
+        return 0
+    along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
+    return int(_crossings(np.ascontiguousarray(pts), along, float(gap), math.sin(LOOP_ANGLE)))
+
+
+@numba.njit(cache=True)
+def _crossings(pts, along, gap, least_sin):  # pragma: no cover - compiled
+    """Proper crossings of segments i and j > i of the polyline ``pts`` whose start is at
+    least ``gap`` beyond the end of i along it (``along``: arc length at each point), at
+    an angle whose sine is at least ``least_sin``."""
+    n = len(pts) - 1
+    count = 0
+    for i in range(n):
+        ax, ay = pts[i, 0], pts[i, 1]
+        bx, by = pts[i + 1, 0], pts[i + 1, 1]
+        lo_x, hi_x = min(ax, bx), max(ax, bx)
+        lo_y, hi_y = min(ay, by), max(ay, by)
+        for j in range(i + 1, n):
+            if along[j] < along[i + 1] + gap:
+                continue
+            cx, cy = pts[j, 0], pts[j, 1]
+            dx, dy = pts[j + 1, 0], pts[j + 1, 1]
+            if max(cx, dx) < lo_x or min(cx, dx) > hi_x or max(cy, dy) < lo_y or min(cy, dy) > hi_y:
+                continue
+            d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+            d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+            d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+            d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+            if d1 * d2 < 0 and d3 * d4 < 0:
+                sine = abs(d2 - d1) / (math.hypot(bx - ax, by - ay) * math.hypot(dx - cx, dy - cy))
+                if sine >= least_sin:
+                    count += 1
+    return count

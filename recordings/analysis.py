@@ -4,7 +4,9 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
 
 - run time: the sim time of the run's last tick; arrival: the time of the
   first tick an AGV reports ``arrived``.
-- distance travelled: the sum of |Δposition| over every tick of the run.
+- distance travelled: the sum of |Δposition| over every tick of the run; loops,
+  how often the driven path crossed itself over the drive
+  (``planner.path_metrics.self_crossings``).
 - path: the first plan that found a path; its key nodes measured with
   ``planner.path_metrics`` (length, turning times, total turning angle);
   replans: plans made for the reason ``replan``.
@@ -67,6 +69,7 @@ class AgvAnalysis:
     plan_time_p95_ms: float | None
     waiting_time: float = 0.0  # s held outside passages
     waits: int = 0  # times it was held
+    self_crossings: int = 0  # its loops: times its driven path crossed itself
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,7 @@ class RunAnalysis:
     agvs: tuple[AgvAnalysis, ...]
     waiting_time: float = 0.0  # s, summed over AGVs
     traffic_events: int = 0  # wait, go and yield events
+    self_crossings: int = 0  # summed over AGVs
 
     @property
     def label(self) -> str:
@@ -174,6 +178,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         agvs=tuple(agvs),
         waiting_time=sum(a.waiting_time for a in agvs),
         traffic_events=len(traffic),
+        self_crossings=sum(a.self_crossings for a in agvs),
     )
 
 
@@ -211,6 +216,7 @@ def _agv(
         plan_time_mean_ms=float(plan_times.mean()) if len(plan_times) else None,
         plan_time_p95_ms=float(np.percentile(plan_times, 95)) if len(plan_times) else None,
         waiting_time=float((status == WAITING).sum() * dt) if dt else 0.0,
+        self_crossings=path_metrics.self_crossings(np.column_stack((x[drive], y[drive]))),
     )
     return agv, plan_times
 
@@ -337,6 +343,7 @@ COMPARED = (
     ("min_clearance_obstacles", "min clearance obstacles", "m"),
     ("min_clearance_agvs", "min clearance AGVs", "m"),
     ("replans", "replans", ""),
+    ("self_crossings", "loops (path self-crossings)", ""),
     ("waiting_time", "waiting time", "s"),
     ("traffic_events", "traffic events", ""),
     ("plan_time_mean_ms", "plan time mean", "ms"),

@@ -21,6 +21,7 @@ AGV_COLUMNS = (
     ("turns", "", "turns", "{}", False),
     ("turning", "deg", "turning_angle_deg", "{:.1f}", False),
     ("replans", "", "replans", "{}", True),
+    ("loops", "", "self_crossings", "{}", False),
     ("accel RMS", "m/s²", "rms_accel", "{:.3f}", True),
     ("jerk RMS", "m/s³", "rms_jerk", "{:.3f}", True),
     ("mean |Δω|", "rad/s", "mean_abs_domega", "{:.4f}", False),
@@ -33,7 +34,9 @@ AGV_COLUMNS = (
     ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
     ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
 )
-HIDDEN_NOTE = "(--wide adds turns, turning angle, |Δω|, ω sign changes, planning and waiting times)"
+HIDDEN_NOTE = (
+    "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, planning and waiting times)"
+)
 
 
 def _cell(value, fmt: str) -> str:
@@ -60,7 +63,18 @@ def run_table(run: RunAnalysis, wide: bool = False) -> str:
     )
     table = text_table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
     note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
-    return f"{table}\n{line}{_traffic_line(run)}{note}"
+    return f"{table}\n{line}{_loops_line(run)}{_traffic_line(run)}{note}"
+
+
+def _loops_line(run: RunAnalysis) -> str:
+    """The AGVs whose driven paths crossed themselves, when any did: loops a user looks at."""
+    if not run.self_crossings:
+        return ""
+    looped = sorted((a for a in run.agvs if a.self_crossings), key=lambda a: -a.self_crossings)
+    each = ", ".join(f"{a.name} {a.self_crossings}" for a in looped[:4])
+    more = f" and {len(looped) - 4} more" if len(looped) > 4 else ""
+    times = f"{run.self_crossings} time{'s' if run.self_crossings != 1 else ''}"
+    return f"\nloops: paths crossed themselves {times} ({each}{more})"
 
 
 def _traffic_line(run: RunAnalysis) -> str:

@@ -128,6 +128,21 @@ def test_omega_sign_changes_and_mean_change_over_the_drive_only(tmp_path):
     assert a.status == "arrived"
 
 
+def test_a_loop_driven_is_counted_and_named_in_the_run_line(tmp_path):
+    # agv a drives on while circling: one full curl (a prolate cycloid from t = pi to 3 pi)
+    t = np.linspace(math.pi, 3 * math.pi, 120)
+    curl = np.column_stack((2.0 + 0.3 * t - 0.8 * np.sin(t), 3.0 - 0.8 * np.cos(t)))
+    ticks = [
+        tick(k, [state("a", k, x, y), state("b", k, 1.0 + 0.05 * k, 6.0)])
+        for k, (x, y) in enumerate(curl)
+    ]
+    run = analyze(write(tmp_path / "r.mcap", ticks))
+    assert [a.self_crossings for a in run.agvs] == [1, 0]
+    assert run.self_crossings == 1
+    assert "loops: paths crossed themselves 1 time (a 1)" in run_table(run)
+    assert "loops:" not in run_table(analyze(write(tmp_path / "s.mcap", ticks[:20])))
+
+
 def test_path_metrics_come_from_the_first_plan_found(tmp_path):
     key_nodes = [[0.0, 0.0], [3.0, 0.0], [3.0, 4.0], [6.0, 8.0]]
     plans = [
@@ -230,6 +245,7 @@ def test_a_real_run_agrees_with_the_worlds_summary(tmp_path):
         assert (got.name, got.status) == (expected.name, expected.status)
         assert got.arrival_time == pytest.approx(expected.arrival_time)
         assert got.distance == pytest.approx(expected.distance, abs=1e-9)
+        assert got.self_crossings == expected.self_crossings
         least = min(got.min_clearance_obstacles, got.min_clearance_agvs)
         assert least == pytest.approx(expected.min_clearance, abs=1e-9)
         assert got.path_length is not None and got.rms_accel > 0

@@ -1,7 +1,7 @@
 """The fast subset of the traffic stress suite (benchmarks/traffic_cases.py) as tests:
 every AGV arrives, nothing collides, no run reaches its time limit, and no AGV loops (drives
-more than ``DETOUR`` times its first route). The whole suite and the cases that still
-miss are in benchmarks/traffic_bench.py and benchmarks/README.md."""
+more than ``DETOUR`` times its first route, or crosses its own track). The whole suite and
+the cases that still miss are in benchmarks/traffic_bench.py and benchmarks/README.md."""
 
 from __future__ import annotations
 
@@ -24,5 +24,6 @@ def test_every_agv_arrives_without_contact(family, seed):
     assert summary.end_reason == "every AGV arrived"
     detours = {a.name: round(a.distance / a.route_length, 2) for a in summary.agvs}
     assert max(detours.values()) <= DETOUR, detours  # waiting aside, yes; loops, no
+    assert not [a.name for a in summary.agvs if a.self_crossings]
     if family == "door":  # one side waited while the other went through
         assert sum(a.waiting_time > 0 for a in summary.agvs) >= 2

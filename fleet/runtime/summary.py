@@ -10,6 +10,7 @@ from planner.agv_status import ARRIVED, FINISHED
 from planner.fusion import GLOBAL_ALGORITHM
 from planner.global_planner import plan_global
 from planner.grid_map import MapError
+from planner.path_metrics import self_crossings
 from recordings.text_table import text_table
 
 
@@ -26,6 +27,7 @@ class AgvSummary:
     clipped: int = 0  # commands the world clipped to the AGV's limits
     refused: int = 0  # reports the world did not believe
     waiting_time: float = 0.0  # s waiting outside passages other AGVs had
+    self_crossings: int = 0  # times its driven path crossed itself: its loops
 
 
 @dataclass(frozen=True)
@@ -63,6 +65,7 @@ class RunSummary:
                     if math.isfinite(a.min_clearance)
                     else None,
                     "waiting_time": round(a.waiting_time, 3),
+                    "self_crossings": a.self_crossings,
                     **({"failure": a.failure} if a.failure else {}),
                     **({"clipped_commands": a.clipped} if a.clipped else {}),
                     **({"refused_reports": a.refused} if a.refused else {}),
@@ -74,8 +77,17 @@ class RunSummary:
     def table(self) -> str:
         """Per AGV, then the run in a line, then each AGV that failed with its reason."""
         header = [
-            ["AGV", "status", "arrival", "distance", "route", "collisions", "min clearance"],
-            ["", "", "s", "m", "m", "", "m"],
+            [
+                "AGV",
+                "status",
+                "arrival",
+                "distance",
+                "route",
+                "loops",
+                "collisions",
+                "min clearance",
+            ],
+            ["", "", "s", "m", "m", "", "", "m"],
         ]
         rows = [
             [
@@ -84,6 +96,7 @@ class RunSummary:
                 "-" if a.arrival_time is None else f"{a.arrival_time:.1f}",
                 f"{a.distance:.2f}",
                 "-" if a.route_length is None else f"{a.route_length:.2f}",
+                str(a.self_crossings),
                 str(a.collisions),
                 f"{a.min_clearance:.2f}" if math.isfinite(a.min_clearance) else "-",
             ]
@@ -118,6 +131,7 @@ def summarize(world: World, wall_time: float) -> RunSummary:
                 r.clipped,
                 r.refused,
                 r.waiting_time,
+                self_crossings(r.track),
             )
         )
     return RunSummary(

@@ -1,0 +1,40 @@
+"""Self-crossings of a driven path: an AGV's loops (``planner.path_metrics``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from planner.path_metrics import LOOP_GAP, self_crossings
+
+
+def _curls(turns: float, advance: float = 0.3, radius: float = 0.8) -> np.ndarray:
+    """A prolate cycloid: a path that drives on while circling, one curl per full turn
+    that advances less than the circle is wide."""
+    t = np.linspace(0.0, 2 * math.pi * turns, int(400 * turns))
+    return np.column_stack((advance * t - radius * np.sin(t), -radius * np.cos(t)))
+
+
+def test_each_curl_driven_crosses_the_track_once():
+    assert self_crossings(_curls(3)) == 2  # curls at t = 2 pi and 4 pi; the ends are halves
+    assert self_crossings(_curls(5)) == 4
+
+
+def test_straight_driving_and_driving_back_along_the_same_line_are_no_loops():
+    assert self_crossings([(0.0, 0.0), (5.0, 0.0)]) == 0
+    assert self_crossings([(0.0, 0.0), (5.0, 0.0), (0.0, 0.01), (5.0, 0.02)]) == 0
+
+
+def test_going_round_the_same_circle_again_is_no_crossing():
+    t = np.linspace(0.0, 2 * math.pi * 1.5, 600)
+    assert self_crossings(np.column_stack((np.cos(t), np.sin(t)))) == 0
+
+
+def test_a_wobble_shorter_than_the_gap_is_one_manoeuvre_not_a_loop():
+    # a figure-eight 0.2 m across: its track crosses itself within far less than LOOP_GAP
+    t = np.linspace(-math.pi / 2, 3 * math.pi / 2, 200)
+    eight = np.column_stack((0.1 * np.sin(t), 0.05 * np.sin(2 * t)))
+    assert self_crossings(eight, gap=0.01) == 1
+    assert self_crossings(eight) == 0 < LOOP_GAP
+    assert self_crossings([(0.0, 0.0)] * 5) == 0  # standing still
