@@ -5,7 +5,7 @@ coming its way, the samples that keep the most clearance over the horizon are
 those that run ahead of it: an AGV met head-on in a 2 m aisle turned and drove
 off with the other behind it, circled back, met the next one and circled again
 (traffic suite warehouse-40 n40 s0: agv9 circled in the cross aisle for 40 s,
-18 self-crossings of its path); in a corridor an AGV backed out metres ahead of
+its path crossing itself 12 times); in a corridor an AGV backed out metres ahead of
 an oncoming pair. The other AGV plans too: one that brakes or steps aside is
 predictable to it, one that flees keeps it coming. So while another AGV can
 lower a sample's clearance, the samples whose displacement over the horizon

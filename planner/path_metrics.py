@@ -97,7 +97,7 @@ def self_crossings(path, gap: float = LOOP_GAP) -> int:
 
 
 @numba.njit(cache=True)
-def _crossings(pts, along, gap, least_sin):  # pragma: no cover - compiled
+def _crossings(pts, along, gap, least_sin):
     """Proper crossings of segments i and j > i of the polyline ``pts`` whose start is at
     least ``gap`` beyond the end of i along it (``along``: arc length at each point), at
     an angle whose sine is at least ``least_sin``."""

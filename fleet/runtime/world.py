@@ -10,6 +10,7 @@ therefore produce the same ticks for the same scenario.
 from __future__ import annotations
 
 import math
+from array import array
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,7 +42,7 @@ class AgvRecord:
     clipped: int = 0  # commands beyond the AGV's limits, clipped by the world
     refused: int = 0  # reports the world did not believe (an arrival away from the goal)
     waiting_time: float = 0.0  # s spent waiting outside a passage (planner/traffic.py)
-    track: list[tuple[float, float]] = field(default_factory=list)  # positions, tick by tick
+    track: array = field(default_factory=lambda: array("d"))  # x, y, x, y, ... tick by tick
 
 
 class World:
@@ -139,7 +140,7 @@ class World:
                     )
         x, y, theta = step_pose(pose, velocity, self.dt)
         record.distance += math.hypot(x - old.x, y - old.y)
-        record.track.append((x, y))
+        record.track.extend((x, y))
         if status == WAITING:
             record.waiting_time += self.dt
         self._take_intent(name, command.intent, status)
