@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
+import signal
 from pathlib import Path
 
 import pytest
+
+# A suite started in the background by a shell without job control (`(bash -c 'pytest' &)`,
+# `nohup ... &`) inherits SIGINT ignored, and so does every process it starts: the Ctrl-C
+# tests then fail with runs that never see their Ctrl-C. Children get the default back.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 # copies of public maps with their sources (tests/data/README.md): a plain clone needs nothing else
 PUBLIC_DATA = Path(__file__).resolve().parent / "data"
