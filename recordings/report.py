@@ -70,23 +70,27 @@ def _loops_line(run: RunAnalysis) -> str:
     """The AGVs whose driven paths crossed themselves, when any did: loops a user looks at."""
     if not run.self_crossings:
         return ""
-    looped = sorted((a for a in run.agvs if a.self_crossings), key=lambda a: -a.self_crossings)
-    each = ", ".join(f"{a.name} {a.self_crossings}" for a in looped[:4])
-    more = f" and {len(looped) - 4} more" if len(looped) > 4 else ""
     times = f"{run.self_crossings} time{'s' if run.self_crossings != 1 else ''}"
-    return f"\nloops: paths crossed themselves {times} ({each}{more})"
+    each = _most(run, lambda a: a.self_crossings, "{}")
+    return f"\nloops: paths crossed themselves {times} ({each})"
 
 
 def _traffic_line(run: RunAnalysis) -> str:
     """The traffic rule's part in the run, when it had one: who waited how long."""
     if not run.traffic_events:
         return ""
-    waited = sorted((a for a in run.agvs if a.waiting_time > 0), key=lambda a: -a.waiting_time)
-    each = ", ".join(f"{a.name} {a.waiting_time:.1f} s" for a in waited[:4])
-    more = f" and {len(waited) - 4} more" if len(waited) > 4 else ""
+    each = _most(run, lambda a: a.waiting_time, "{:.1f} s")
     return f"\ntraffic: {run.traffic_events} decisions, {run.waiting_time:.1f} s waiting in all" + (
-        f" ({each}{more})" if each else ""
+        f" ({each})" if each else ""
     )
+
+
+def _most(run: RunAnalysis, value, fmt: str, shown: int = 4) -> str:
+    """The AGVs with a positive ``value``, largest first: the first ``shown`` named with
+    it ("agv3 2, agv1 1"), the rest counted ("and 3 more"); empty when there are none."""
+    ranked = sorted((a for a in run.agvs if value(a) > 0), key=lambda a: -value(a))
+    each = ", ".join(f"{a.name} {fmt.format(value(a))}" for a in ranked[:shown])
+    return each + (f" and {len(ranked) - shown} more" if len(ranked) > shown else "")
 
 
 def comparison_table(runs: list[RunAnalysis]) -> str:
