@@ -81,6 +81,7 @@ class RecordingWriter:
 
     def __init__(self, path, *, scenario_name: str, scenario_text: str, run_facts: dict):
         self.path = Path(path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)  # as the default runs/ is
         self._file = open(self.path, "wb")  # noqa: SIM115 (closed by finish/close)
         self._mcap = Writer(self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD)
         self._mcap.start(library=f"agv-fleet/{tool_version()} {LIBRARY_IDENTIFIER}")

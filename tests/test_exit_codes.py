@@ -116,3 +116,21 @@ def test_run_json_names_the_recording(tmp_path, capsys):
     assert json.loads(capsys.readouterr().out)["recording"] == str(path)
     assert main(["run", "corridor", "--in-process", "-q", "--json", "--no-record"]) == 0
     assert json.loads(capsys.readouterr().out)["recording"] is None
+
+
+def test_run_makes_the_folders_of_its_recording(tmp_path):
+    """``-o`` into folders that do not exist yet (as the default ``runs/``): the recorder
+    process of a Zenoh run used to fail with 'No such file or directory'."""
+    from mcap.reader import make_reader
+
+    path = tmp_path / "runs" / "today" / "c.mcap"
+    done = subprocess.run(
+        [*CLI, "run", "corridor", "-q", "-o", str(path)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == exit_codes.OK, done.stderr
+    with path.open("rb") as stream:
+        topics = {c.topic for c in make_reader(stream).get_summary().channels.values()}
+    assert {"world/result", "agv/left/command", "agv/right/command"} <= topics
