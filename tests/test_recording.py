@@ -318,6 +318,17 @@ def test_cli_info_and_analyze_recover_a_truncated_recording(truncated):
     assert "truncated" in analysis.stderr
 
 
+def test_cli_analyze_of_a_recording_cut_before_any_tick_is_one_line_and_exit_2(corridor, tmp_path):
+    cut = tmp_path / "early.mcap"
+    cut.write_bytes(corridor[0].read_bytes()[:3000])  # the header and metadata only
+    analysis = agv_fleet("analyze", str(cut))
+    assert analysis.returncode == 2 and analysis.stdout == ""
+    assert len(analysis.stderr.strip().splitlines()) == 1, analysis.stderr
+    assert "holds no AGV of a run to analyze (truncated" in analysis.stderr
+    scenario = agv_fleet("info", str(cut), "--scenario")  # what was recorded is not lost
+    assert scenario.returncode == 0 and "left" in scenario.stdout
+
+
 def test_cli_bad_input_is_one_line_and_exit_2(tmp_path):
     junk = tmp_path / "junk.mcap"
     junk.write_bytes(b"\x00" * 100)

@@ -2,7 +2,9 @@
 
 Bad input (a missing file, not MCAP, not an agv-fleet recording) is one line on
 stderr and exit 2. A truncated recording is recovered: a note on stderr, the
-output as usual, exit 0.
+output as usual, exit 0; ``analyze`` of one that holds no AGV of a run (cut before its
+first complete chunk: ``info --scenario`` still recovers the scenario) is bad input,
+one line.
 """
 
 from __future__ import annotations
@@ -62,9 +64,13 @@ def add_parsers(sub) -> None:
 
 def _open(path: str, command: str) -> Recording:
     rec = open_recording(path)
+    _note_truncation(rec, path, command)
+    return rec
+
+
+def _note_truncation(rec: Recording, path: str, command: str) -> None:
     if rec.truncated:
         print(f"agv-fleet {command}: {path} is truncated: {rec.recovered_note}", file=sys.stderr)
-    return rec
 
 
 def run_info(args: argparse.Namespace) -> int:
@@ -82,9 +88,13 @@ def run_info(args: argparse.Namespace) -> int:
 def run_analyze(args: argparse.Namespace) -> int:
     runs = []
     for path in args.recordings:
-        rec = _open(path, "analyze")
+        rec = open_recording(path)
         series = extract(rec)
         run = analyze(rec, series)
+        if not run.agvs:  # a table of nothing would read as an empty success
+            cut = f" (truncated: {rec.recovered_note})" if rec.truncated else ""
+            raise RecordingError(f"{path} holds no AGV of a run to analyze{cut}")
+        _note_truncation(rec, path, "analyze")
         runs.append(run)
         if rec.undecodable:
             print(
