@@ -313,6 +313,15 @@ def test_a_truncated_recording_replays_what_was_recovered_and_says_so(corridor, 
     assert len(read_rrd(out)["/velocity/speed/left"].rows) == len(states)
 
 
+def test_a_recording_cut_before_any_message_is_one_line_and_exit_2(corridor, tmp_path):
+    cut = tmp_path / "early.mcap"
+    cut.write_bytes(corridor["mcap"].read_bytes()[:3000])  # the header and metadata only
+    done = agv_fleet("replay", str(cut), "--save", str(tmp_path / "early.rrd"))
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert "holds no message to replay" in done.stderr
+    assert not (tmp_path / "early.rrd").exists()
+
+
 def listening_hosts(pid: int) -> set[str]:
     """The local addresses (hex, as in /proc/net/tcp) that a process listens on."""
     inodes = set()

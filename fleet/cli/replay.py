@@ -8,7 +8,7 @@ import sys
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError, positive_float
 from fleet.runtime.launcher import sigterm_as_interrupt
-from recordings.reader import open_recording
+from recordings.reader import RecordingError, open_recording
 from recordings.rerun_view import require_display, save_rrd, serve_web, spawn_viewer
 
 
@@ -59,6 +59,10 @@ def replay(args: argparse.Namespace) -> int:
     if viewer:
         require_display()  # before reading what could not be shown
     recording = open_recording(args.recording)
+    if recording.truncated and not recording.messages:  # an empty view is no replay
+        raise RecordingError(
+            f"{args.recording} holds no message to replay ({recording.recovered_note})"
+        )
     if recording.truncated:
         print(
             f"agv-fleet replay: {args.recording} is cut short ({recording.recovered_note}); "
