@@ -89,19 +89,26 @@ def self_crossings(path, gap: float = LOOP_GAP) -> int:
     """How often ``path`` crosses itself, between stretches at least ``gap`` apart along it
     and at an angle of at least ``LOOP_ANGLE`` (a curl driven once crosses its own track
     once; driving back along the same line, or round the same circle again, does not)."""
+    return len(crossing_points(path, gap))
+
+
+def crossing_points(path, gap: float = LOOP_GAP) -> np.ndarray:
+    """(K, 2) the points where ``path`` crosses itself, as ``self_crossings`` counts them
+    (in the order of the earlier stretch): where an AGV looped."""
     pts = _points(path)
     if len(pts) < 4:
-        return 0
+        return np.zeros((0, 2))
     along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
-    return int(_crossings(np.ascontiguousarray(pts), along, float(gap), math.sin(LOOP_ANGLE)))
+    return _crossings(np.ascontiguousarray(pts), along, float(gap), math.sin(LOOP_ANGLE))
 
 
 @numba.njit(cache=True)
 def _crossings(pts, along, gap, least_sin):
-    """Proper crossings of segments i and j > i of the polyline ``pts`` whose start is at
+    """Where segments i and j > i of the polyline ``pts`` properly cross, j starting at
     least ``gap`` beyond the end of i along it (``along``: arc length at each point), at
     an angle whose sine is at least ``least_sin``."""
     n = len(pts) - 1
+    out = np.empty((8, 2))
     count = 0
     for i in range(n):
         ax, ay = pts[i, 0], pts[i, 1]
@@ -122,5 +129,10 @@ def _crossings(pts, along, gap, least_sin):
             if d1 * d2 < 0 and d3 * d4 < 0:
                 sine = abs(d2 - d1) / (math.hypot(bx - ax, by - ay) * math.hypot(dx - cx, dy - cy))
                 if sine >= least_sin:
+                    if count == len(out):
+                        out = np.concatenate((out, np.empty_like(out)))
+                    t = d1 / (d1 - d2)  # where c -> d meets the line of a -> b
+                    out[count, 0] = cx + t * (dx - cx)
+                    out[count, 1] = cy + t * (dy - cy)
                     count += 1
-    return count
+    return out[:count].copy()

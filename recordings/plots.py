@@ -10,8 +10,10 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from matplotlib.patheffects import withStroke
 
 from planner.motion import world_velocity
+from planner.path_metrics import crossing_points
 from recordings.series import RunSeries
 
 DPI = 100
@@ -22,7 +24,7 @@ def save_plots(series: RunSeries, out_dir: Path, stem: str, label: str) -> list[
     """Write ``<stem>-map.png`` and ``<stem>-velocity-<agv>.png`` into ``out_dir``,
     titled with ``label`` (scenario and algorithm: which run it is)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [_save(_map_figure(series, label), out_dir / f"{stem}-map.png")]
+    paths = [_save(map_figure(series, label), out_dir / f"{stem}-map.png")]
     for i, name in enumerate(series.agvs.names):
         figure = _velocity_figure(series, i, label)
         paths.append(_save(figure, out_dir / f"{stem}-velocity-{name}.png"))
@@ -35,7 +37,7 @@ def _save(figure: Figure, path: Path) -> Path:
     return path
 
 
-def _map_figure(series: RunSeries, label: str) -> Figure:
+def map_figure(series: RunSeries, label: str) -> Figure:
     grid = series.grid
     width, height = grid.size_m if grid else (10.0, 10.0)
     x0, x1, y0, y1 = grid.extent if grid else (0.0, width, 0.0, height)
@@ -65,12 +67,21 @@ def _map_figure(series: RunSeries, label: str) -> Figure:
         ax.plot(x, y, color=colour, lw=1.6, label=name)
         if len(x):
             ax.plot(x[0], y[0], "s", color=colour, ms=5)
+        track = np.column_stack((x, y))
+        loops = crossing_points(track[np.isfinite(track).all(axis=1)])
+        if len(loops):  # where the AGV looped: analyze's loops, each where it happened
+            ax.plot(
+                loops[:, 0], loops[:, 1], "x", color=colour, ms=10, mew=2.5, zorder=5,
+                path_effects=[withStroke(linewidth=4.5, foreground="black")],
+            )  # fmt: skip
     ax.set_xlim(x0, x1)
     ax.set_ylim(y0, y1)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"{label}\ntrajectories (solid), first global path (dotted), key nodes (o)")
+    ax.set_title(
+        f"{label}\ntrajectories (solid), first global path (dotted), key nodes (o), loops (x)"
+    )
     if 0 < len(series.agvs.names) <= LEGEND_MAX:
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     figure.tight_layout()

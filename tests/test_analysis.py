@@ -16,8 +16,9 @@ from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from planner.dwa import step_pose
 from planner.motion import world_velocity
+from planner.path_metrics import crossing_points
 from recordings.analysis import analyze, compare
-from recordings.plots import save_plots
+from recordings.plots import map_figure, save_plots
 from recordings.reader import open_recording
 from recordings.report import comparison_table, run_table, to_csv, to_json
 from recordings.series import extract
@@ -141,6 +142,11 @@ def test_a_loop_driven_is_counted_and_named_in_the_run_line(tmp_path):
     assert run.self_crossings == 1
     assert "loops: paths crossed themselves 1 time (a 1)" in run_table(run)
     assert "loops:" not in run_table(analyze(write(tmp_path / "s.mcap", ticks[:20])))
+    # the map plot marks where: one x in a's colour at the crossing, none for b
+    figure = map_figure(extract(open_recording(tmp_path / "r.mcap")), "looping")
+    marks = [line for line in figure.axes[0].lines if line.get_marker() == "x"]
+    assert len(marks) == 1 and marks[0].get_color() == "C0"
+    assert np.column_stack(marks[0].get_data()) == pytest.approx(crossing_points(curl))
 
 
 def test_path_metrics_come_from_the_first_plan_found(tmp_path):

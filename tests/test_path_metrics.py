@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from planner.path_metrics import LOOP_GAP, self_crossings
+from planner.path_metrics import LOOP_GAP, crossing_points, self_crossings
 
 
 def _curls(turns: float, advance: float = 0.3, radius: float = 0.8) -> np.ndarray:
@@ -38,3 +38,12 @@ def test_a_wobble_shorter_than_the_gap_is_one_manoeuvre_not_a_loop():
     assert self_crossings(eight, gap=0.01) == 1
     assert self_crossings(eight) == 0 < LOOP_GAP
     assert self_crossings([(0.0, 0.0)] * 5) == 0  # standing still
+
+
+def test_crossing_points_are_where_the_track_crosses_itself():
+    loop = [(0.0, 0.0), (4.0, 0.0), (4.0, 2.0), (2.0, 2.0), (2.0, -2.0)]
+    assert crossing_points(loop).tolist() == [[2.0, 0.0]]
+    points = crossing_points(_curls(5))
+    assert len(points) == self_crossings(_curls(5)) == 4
+    assert np.all(np.diff(points[:, 0]) > 0)  # one per curl, in the order driven
+    assert crossing_points([(0.0, 0.0), (5.0, 0.0)]).shape == (0, 2)
