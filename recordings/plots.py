@@ -38,6 +38,8 @@ def _save(figure: Figure, path: Path) -> Path:
 
 
 def map_figure(series: RunSeries, label: str) -> Figure:
+    """The map with each AGV's trajectory, first global path, key nodes and loops (the
+    points where its track crossed itself, as ``analyze`` counts them)."""
     grid = series.grid
     width, height = grid.size_m if grid else (10.0, 10.0)
     x0, x1, y0, y1 = grid.extent if grid else (0.0, width, 0.0, height)
