@@ -15,7 +15,6 @@ from __future__ import annotations
 import json
 import os
 import socket
-import tempfile
 import time
 import uuid
 from dataclasses import dataclass
@@ -49,11 +48,13 @@ def run_prefix(run_id: str) -> str:
     return f"agv-fleet/{run_id}"
 
 
-def fresh_endpoint(transport: str = "unix", folder: str | None = None) -> str:
-    """A listen endpoint nobody else uses: a Unix socket in ``folder`` (default: a new
-    temporary folder), or a free TCP port on 127.0.0.1 (``transport="tcp"``)."""
+def fresh_endpoint(transport: str = "unix", folder: str | os.PathLike | None = None) -> str:
+    """A listen endpoint nobody else uses: a Unix socket in ``folder`` (the caller's
+    private folder, which it removes after the run), or a free TCP port on 127.0.0.1
+    (``transport="tcp"``)."""
     if transport == "unix":
-        folder = folder or tempfile.mkdtemp(prefix="agv-fleet-")
+        if folder is None:
+            raise ValueError("a Unix socket endpoint needs a folder to put the socket in")
         return f"unixsock-stream/{os.path.join(folder, 'zenoh.sock')}"
     if transport == "tcp":
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:

@@ -38,7 +38,7 @@ def _in_process_agvs(scenario="crossing"):
 
 
 def test_agvs_and_recorder_exit_3_within_2_s_saying_why_when_the_world_is_killed(tmp_path):
-    endpoint, prefix = fresh_endpoint(), f"test/{new_run_id()}"
+    endpoint, prefix = fresh_endpoint("unix", tmp_path), f"test/{new_run_id()}"
     common = ["crossing", "--prefix", prefix]
     path = tmp_path / "partial.mcap"
     world = subprocess.Popen(

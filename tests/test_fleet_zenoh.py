@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from contextlib import contextmanager
@@ -34,7 +35,8 @@ def state_key(state):
 def hosted_world(scenario_name: str, **server_options):
     """The world in this process on a fresh bus; the AGVs in real processes."""
     scenario = load_scenario(scenario_name)
-    endpoint, prefix = fresh_endpoint(), run_prefix(new_run_id())
+    folder = tempfile.TemporaryDirectory(prefix="agv-fleet-test-")
+    endpoint, prefix = fresh_endpoint("unix", folder.name), run_prefix(new_run_id())
     names = [arg for a in scenario.agvs for arg in ("--name", a.name)]
     host = subprocess.Popen(
         [*CLI, "agv", scenario_name, *names, "--connect", endpoint, "--prefix", prefix],
@@ -50,6 +52,7 @@ def hosted_world(scenario_name: str, **server_options):
         except subprocess.TimeoutExpired:
             host.terminate()
             host.wait(timeout=10)
+        folder.cleanup()
 
 
 def test_zenoh_and_in_process_runs_are_identical_tick_by_tick():
@@ -231,9 +234,9 @@ def test_world_and_agvs_started_by_hand_over_tcp():
     assert json.loads(world.stdout)["agvs"] == alone["agvs"]
 
 
-def test_an_agv_with_no_world_gives_up_with_one_line():
+def test_an_agv_with_no_world_gives_up_with_one_line(tmp_path):
     proc = subprocess.run(
-        [*CLI, "agv", "corridor", "--name", "left", "--connect", fresh_endpoint(),
+        [*CLI, "agv", "corridor", "--name", "left", "--connect", fresh_endpoint("unix", tmp_path),
          "--connect-timeout", "1"],
         capture_output=True,
         text=True,

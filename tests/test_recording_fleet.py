@@ -12,7 +12,7 @@ import subprocess
 import sys
 import time
 
-from recordings.reader import open_recording
+from recordings.reader import RecordingError, open_recording
 from tests.processes import fleet_processes
 
 CLI = [sys.executable, "-m", "fleet.cli"]
@@ -73,6 +73,20 @@ def _recorder_pid(timeout=30.0) -> int:
     raise AssertionError("no recorder process")
 
 
+def _wait_for_recorded(path, topic: str, more_than: int, timeout: float = 120.0) -> None:
+    """Wait until the recording being written holds more than ``more_than`` messages on
+    ``topic`` (a fixed sleep recorded too little on a loaded machine)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            if len(open_recording(path).of(topic)) > more_than:
+                return
+        except RecordingError:
+            pass  # not there yet, or no chunk written yet
+        time.sleep(0.2)
+    raise AssertionError(f"{path} never held more than {more_than} {topic} messages")
+
+
 def test_a_recorder_killed_mid_run_is_exit_3_naming_what_its_readable_recording_holds(tmp_path):
     path = tmp_path / "killed.mcap"
     run = subprocess.Popen(
@@ -82,7 +96,7 @@ def test_a_recorder_killed_mid_run_is_exit_3_naming_what_its_readable_recording_
         text=True,
     )
     recorder = _recorder_pid()
-    time.sleep(4.0)  # ~20 s of the 44 s simulated
+    _wait_for_recorded(path, "agv/west/command", more_than=50)  # of about 440 ticks
     os.kill(recorder, signal.SIGKILL)
     out, err = run.communicate(timeout=300)
     # the run itself goes on without its recorder, then says what the file holds

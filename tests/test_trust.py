@@ -85,10 +85,10 @@ def test_a_zenoh_config_with_tls_or_a_user_dictionary_counts_as_secured(tmp_path
     assert not has_authentication(str(plain)) and not has_authentication(None)
 
 
-def test_one_agv_command_refuses_the_same_name_twice():
+def test_one_agv_command_refuses_the_same_name_twice(tmp_path):
     proc = subprocess.run(
         [*CLI, "agv", "corridor", "--name", "left", "--name", "left", "--connect",
-         fresh_endpoint()],
+         fresh_endpoint("unix", tmp_path)],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert proc.returncode == 2
