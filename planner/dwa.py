@@ -196,6 +196,21 @@ def window_axis(current: float, lowest: float, highest: float, reach: float, ste
 
 def dynamic_window(config: DwaConfig, command: Command) -> np.ndarray:
     """(N, 3) sampled commands of the window (Eqs. 5, 6), speed-limited in |(vx, vy)|."""
+    return window(config, command).commands
+
+
+@dataclass(frozen=True)
+class Window:
+    """The window's samples, with the distinct turn rates they hold (ascending) and each
+    sample's index into them: what ``rollout`` would otherwise find with ``np.unique``."""
+
+    commands: np.ndarray
+    omegas: np.ndarray
+    which: np.ndarray
+
+
+def window(config: DwaConfig, command: Command) -> Window:
+    """``dynamic_window``'s samples as a ``Window``."""
     vx, vy, omega = command
     dv = config.max_accel * config.dt
     vxs = window_axis(vx, config.min_vx, config.max_speed, dv, config.v_resolution)
@@ -209,7 +224,10 @@ def dynamic_window(config: DwaConfig, command: Command) -> np.ndarray:
     grid[..., 1] = vys[:, None]
     grid[..., 2] = omegas
     grid = grid.reshape(-1, 3)
-    return grid[np.hypot(grid[:, 0], grid[:, 1]) <= config.max_speed + _EPS]
+    kept = np.hypot(grid[:, 0], grid[:, 1]) <= config.max_speed + _EPS
+    # every turn rate is kept with the same speeds: the speed limit drops none of them
+    which = (np.arange(len(grid)) % len(omegas))[kept]
+    return Window(grid[kept], omegas, which)
 
 
 def braking_command(config: DwaConfig, command: Command) -> Command:
@@ -223,10 +241,16 @@ def braking_command(config: DwaConfig, command: Command) -> Command:
     )
 
 
-def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarray:
-    """(3, N, K): x, y and theta after steps 1..K of each command held constant (Eq. 4)."""
+def rollout(
+    pose: Pose, commands: np.ndarray, dt: float, steps: int, samples: Window | None = None
+) -> np.ndarray:
+    """(3, N, K): x, y and theta after steps 1..K of each command held constant (Eq. 4).
+    ``samples``: ``commands`` as a ``Window`` (its turn rates need no search)."""
     x0, y0, theta0 = pose
-    omegas, which = np.unique(commands[:, 2], return_inverse=True)
+    if samples is None:
+        omegas, which = np.unique(commands[:, 2], return_inverse=True)
+    else:
+        omegas, which = samples.omegas, samples.which
     headings = theta0 + omegas[:, None] * (np.arange(steps + 1) * dt)  # (W, K+1), steps 0..K
     # the displacement of step k uses the heading at its start (step k-1)
     cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)
@@ -319,22 +343,26 @@ def lower_by_discs(xs, ys, clearance, moving, dt, radius):
     return out
 
 
+def sample_reach(pose: Pose, xs: np.ndarray, ys: np.ndarray) -> float:
+    """How far from ``pose`` the samples' trajectories (N, K) reach."""
+    return math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
+
+
 def relevant_discs(
-    config: DwaConfig, pose: Pose, xs: np.ndarray, ys: np.ndarray, discs: np.ndarray, bound: float
+    config: DwaConfig, pose: Pose, agv_reach: float, discs: np.ndarray, bound: float
 ) -> np.ndarray:
     """The discs that can lower some trajectory's clearance below ``bound``.
 
     ``bound`` is the largest static clearance over the samples: a disc that
     cannot come closer than that to any trajectory point within the horizon
-    (its distance now, less how far the AGV and the disc can travel) changes
-    no sample's minimum clearance, so dropping it changes nothing. With many
-    AGVs on a map most discs are such, and the clearance kernel's cost is
-    linear in the number of discs. The nearest come first: ``lower_by_discs`` then
-    finds a trajectory's clearance early and skips more of the others.
+    (its distance now, less how far the AGV (``agv_reach``: ``sample_reach``) and the
+    disc can travel) changes no sample's minimum clearance, so dropping it changes
+    nothing. With many AGVs on a map most discs are such, and the clearance kernel's
+    cost is linear in the number of discs. The nearest come first: ``lower_by_discs``
+    then finds a trajectory's clearance early and skips more of the others.
     """
     if not len(discs):
         return discs
-    agv_reach = math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
     disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * config.horizon_s
     gap_now = np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
     (kept,) = np.nonzero(gap_now - agv_reach - disc_reach < bound)
@@ -543,8 +571,9 @@ class DwaPlanner:
         field = self.distance_field
         discs = np.zeros((0, 5)) if moving is None else np.asarray(moving, dtype=float)
         discs = np.ascontiguousarray(discs.reshape(-1, 5))
-        commands = dynamic_window(cfg, command)
-        xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps)
+        samples = window(cfg, command)
+        commands = samples.commands
+        xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps, samples)
         clearance = static_clearance(
             xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
         )
@@ -558,8 +587,9 @@ class DwaPlanner:
         # between evading and braking looks at them), of which those that can lower a
         # clearance below the best static one
         bound = static_best if braking is None else max(static_best, float(braking.max()))
-        discs = relevant_discs(cfg, pose, xs, ys, every_disc, bound)
-        lowering = relevant_discs(cfg, pose, xs, ys, discs, static_best)
+        span = sample_reach(pose, xs, ys)
+        discs = relevant_discs(cfg, pose, span, every_disc, bound)
+        lowering = relevant_discs(cfg, pose, span, discs, static_best)
         if len(lowering):
             clearance = lower_by_discs(xs, ys, clearance, lowering, cfg.dt, cfg.radius)
         offsets = None  # how far each sample strays from the route: the lane and the score
@@ -571,7 +601,7 @@ class DwaPlanner:
             # ever relaxes
             braking = np.where((offsets <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
             # the gap to moving discs bounds the room too (Eq. 7 for them)
-            near = relevant_discs(cfg, pose, xs, ys, discs, float(braking.max()))
+            near = relevant_discs(cfg, pose, span, discs, float(braking.max()))
             if len(near):
                 braking = lower_by_discs(xs, ys, braking, near, cfg.dt, cfg.radius)
             braking = np.maximum(braking, clearance)
@@ -589,7 +619,7 @@ class DwaPlanner:
             mask &= speed <= limit + _EPS
         ok = np.flatnonzero(mask)
         if ok.size == 0:
-            if self.behaviour.evade and self._evade_from(pose, xs, ys, discs, walkers, static_best):
+            if self.behaviour.evade and self._evade_from(pose, span, discs, walkers, static_best):
                 times = contact_times(
                     xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius,
                     *field.origin,
@@ -685,7 +715,7 @@ class DwaPlanner:
             clearance = lower_by_discs(xs, ys, clearance, discs, cfg.dt, cfg.radius)
         return float(clearance[0])
 
-    def _evade_from(self, pose, xs, ys, discs, walkers, bound: float) -> bool:
+    def _evade_from(self, pose, reach: float, discs, walkers, bound: float) -> bool:
         """Whether the evasive fallback applies: against walls and walkers, not when the only
         moving discs in reach are AGVs. They plan too; an AGV that brakes is predictable to
         them, one that flees at full speed into a crowded aisle is not (the stress suite's
@@ -695,7 +725,7 @@ class DwaPlanner:
         if walkers is None or not len(walkers):
             return False
         walkers = np.ascontiguousarray(np.asarray(walkers, dtype=float).reshape(-1, 5))
-        return len(relevant_discs(self.config, pose, xs, ys, walkers, bound)) > 0
+        return len(relevant_discs(self.config, pose, reach, walkers, bound)) > 0
 
     def threatened(self, pose: Pose, moving: np.ndarray | None) -> bool:
         """True when standing still at ``pose`` a moving disc reaches the AGV within the horizon."""

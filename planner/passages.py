@@ -62,6 +62,20 @@ class Crossing:
 
 
 @dataclass(frozen=True, eq=False)
+class RouteCells:
+    """A route sampled every half cell (``Passages.route_cells``): each sample's distance
+    along the route, cell, whether that cell is on the map, and its passage (or NONE).
+    An AGV's route changes only at a key node or a replan, so its guard samples it once
+    and not on every tick (the sampling was a tenth of a 50-AGV fleet's planning time)."""
+
+    along: np.ndarray
+    cols: np.ndarray
+    rows: np.ndarray
+    inside: np.ndarray
+    labels: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
 class Passages:
     """The passages of one map for one AGV clearance (see module doc)."""
 
@@ -175,25 +189,32 @@ class Passages:
             self._centres_of[passage] = centres
         return centres
 
-    def first_crossing(
-        self, route: list[Point], lookahead: float, start_at: float = 0.0
-    ) -> Crossing | None:
-        """The first passage ``route`` (a polyline, world frame) enters between
-        ``start_at`` and ``start_at + lookahead`` metres along it, or None; distances in
-        the result are from ``start_at``. Where the route leaves the passage (its last
-        sample inside before a stretch longer than a waiting place outside) is found on
-        the whole route."""
+    def route_cells(self, route: list[Point]) -> RouteCells:
+        """``route`` sampled every half cell, with the cell and passage of each sample."""
         points, along = _samples(route, self.grid.resolution / 2)
-        ahead = along >= start_at - self.grid.resolution / 2
-        points, along = points[ahead], np.maximum(along[ahead] - start_at, 0.0)
-        if not len(points):
-            return None
         res = self.grid.resolution
         cols = np.floor((points[:, 0] - self.grid.origin[0]) / res).astype(np.int64)
         rows = np.floor((points[:, 1] - self.grid.origin[1]) / res).astype(np.int64)
         inside = (cols >= 0) & (cols < self.grid.width) & (rows >= 0) & (rows < self.grid.height)
         labels = np.full(len(points), NONE)
         labels[inside] = self.label[rows[inside], cols[inside]]
+        return RouteCells(along, cols, rows, inside, labels)
+
+    def first_crossing(
+        self, route: list[Point] | RouteCells, lookahead: float, start_at: float = 0.0
+    ) -> Crossing | None:
+        """The first passage ``route`` (a polyline, world frame, or its ``route_cells``)
+        enters between ``start_at`` and ``start_at + lookahead`` metres along it, or None;
+        distances in the result are from ``start_at``. Where the route leaves the passage
+        (its last sample inside before a stretch longer than a waiting place outside) is
+        found on the whole route."""
+        cells = route if isinstance(route, RouteCells) else self.route_cells(route)
+        ahead = cells.along >= start_at - self.grid.resolution / 2
+        if not ahead.any():
+            return None
+        along = np.maximum(cells.along[ahead] - start_at, 0.0)
+        cols, rows = cells.cols[ahead], cells.rows[ahead]
+        inside, labels = cells.inside[ahead], cells.labels[ahead]
         hits = np.flatnonzero(labels != NONE)
         if not len(hits) or along[hits[0]] > lookahead:
             return None
@@ -203,7 +224,7 @@ class Passages:
         gaps = np.flatnonzero(np.diff(along[mine]) > self.join_distance)
         last = int(mine[gaps[0]] if len(gaps) else mine[-1])
         exit = entry = None
-        if last + 1 < len(points) and inside[last + 1]:
+        if last + 1 < len(labels) and inside[last + 1]:
             exit = self._mouth_near(int(cols[last + 1]), int(rows[last + 1]), passage)
         if first > 0 and inside[first - 1]:
             entry = self._mouth_near(int(cols[first - 1]), int(rows[first - 1]), passage)

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from planner.costmap import Costmap
 from planner.dwa import DwaConfig
 from planner.grid_map import Point
-from planner.passages import Crossing, Passages
+from planner.passages import Crossing, Passages, RouteCells
 from planner.path_metrics import distance_to_path
 from planner.traffic import (
     BACK,
@@ -87,6 +87,9 @@ class TrafficGuard:
         self._ahead = 0  # AGVs queued before it on its side when its waiting place was chosen
         self._parked: list[tuple[float, float, float]] = []
         self._waiting: list[tuple[float, float, float]] = []  # other AGVs held, last tick
+        self._route: list[Point] = []  # the route of the last tick, its samples and the
+        self._route_cells: RouteCells | None = None  # part of it an intent shares
+        self._shared_ahead: list[list[float]] = []
 
     def park(self, discs) -> None:
         """AGVs stopped for good (arrived, failed) at (x, y, radius): no waiting place within
@@ -109,9 +112,13 @@ class TrafficGuard:
         from the start of its current segment (the AGV is somewhere along, or beside,
         that segment); ``intents`` are the fleet's of the last tick (the world's tick
         carries them)."""
-        shared = [[round(x, 2), round(y, 2)] for x, y in [position, *route[1:ROUTE_POINTS]]]
+        if route != self._route:  # a new segment or a replan: sampled once, not per tick
+            self._route, self._route_cells = route, self.passages.route_cells(route)
+            self._shared_ahead = [[round(x, 2), round(y, 2)] for x, y in route[1:ROUTE_POINTS]]
+        position_shared = [round(position[0], 2), round(position[1], 2)]
+        shared = [position_shared, *(list(p) for p in self._shared_ahead)]
         along = _projection(route, position)
-        crossing = self.passages.first_crossing(route, self._reach(), along)
+        crossing = self.passages.first_crossing(self._route_cells, self._reach(), along)
         beyond = crossing is not None and crossing.enter_at > self.request_distance
         if beyond and (self._claim is None or crossing.passage != self._claim[0]):
             crossing = None  # only a held claim reaches beyond the request distance

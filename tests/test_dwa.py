@@ -20,6 +20,8 @@ from planner.dwa import (
     route_offsets,
     static_clearance,
     step_pose,
+    window,
+    window_axis,
 )
 from planner.grid_map import GridMap
 
@@ -118,8 +120,27 @@ def test_window_size_at_the_papers_resolution():
 
 
 def test_a_command_beyond_the_limits_is_brought_back_at_full_deceleration():
-    samples = dynamic_window(CFG, (2.5, 0.0, 0.0))
-    assert np.all(samples[:, 0] == pytest.approx(2.48))
+    dv = CFG.max_accel * CFG.dt
+    axis = window_axis(2.5, CFG.min_vx, CFG.max_speed, dv, CFG.v_resolution)
+    assert axis.tolist() == pytest.approx([2.5 - dv])
+
+
+@pytest.mark.parametrize(
+    "command",
+    [(0.5, 0.1, 5 * DEG), (0.0, 0.0, 0.0), (1.95, 0.3, -19 * DEG), (0.3, 0.0, 80 * DEG),
+     (1.99, 0.2, 0.0)],
+)  # fmt: skip
+def test_the_windows_turn_rates_roll_out_as_a_search_for_them_would(command):
+    samples = window(CFG, command)
+    omegas, which = np.unique(samples.commands[:, 2], return_inverse=True)
+    np.testing.assert_array_equal(samples.omegas[samples.which], samples.commands[:, 2])
+    np.testing.assert_array_equal(samples.omegas, omegas)
+    np.testing.assert_array_equal(samples.which, which)
+    pose = (3.0, 4.0, 0.7)
+    np.testing.assert_array_equal(
+        rollout(pose, samples.commands, CFG.dt, CFG.steps, samples),
+        rollout(pose, samples.commands, CFG.dt, CFG.steps),
+    )
 
 
 # --- clearance and admissibility ------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Self-crossings of a driven path: an AGV's loops (``planner.path_metrics``)."""
+"""Self-crossings of a driven path (an AGV's loops) and turn angles (``planner.path_metrics``)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,13 @@ import math
 
 import numpy as np
 
-from planner.path_metrics import LOOP_GAP, crossing_points, self_crossings
+from planner.path_metrics import (
+    LOOP_GAP,
+    crossing_points,
+    heading_changes_deg,
+    self_crossings,
+    turn_angle,
+)
 
 
 def _curls(turns: float, advance: float = 0.3, radius: float = 0.8) -> np.ndarray:
@@ -47,3 +53,19 @@ def test_crossing_points_are_where_the_track_crosses_itself():
     assert len(points) == self_crossings(_curls(5)) == 4
     assert np.all(np.diff(points[:, 0]) > 0)  # one per curl, in the order driven
     assert crossing_points([(0.0, 0.0), (5.0, 0.0)]).shape == (0, 2)
+
+
+def test_turn_angle_is_the_heading_change_of_the_three_points_bit_for_bit():
+    rng = np.random.default_rng(7)
+    for i in range(3000):
+        points = rng.normal(size=(3, 2)) * rng.choice([0.01, 1.0, 100.0])
+        if i % 5 == 0:
+            points = np.round(points, 1)  # on a grid: right angles, straight on, U-turns
+        if i % 7 == 0:
+            points[1] = points[0 if i % 2 else 2]  # a repeated point: no heading
+        before, node, after = (tuple(float(v) for v in p) for p in points)
+        change = heading_changes_deg([before, node, after])
+        expected = math.radians(abs(float(change[0]))) if len(change) else 0.0
+        assert turn_angle(before, node, after) == expected
+    assert turn_angle((0.0, 0.0), (1.0, 0.0), (1.0, 1.0)) == math.pi / 2
+    assert turn_angle((0.0, 0.0), (1.0, 0.0), (0.0, 0.0)) == math.pi

@@ -147,6 +147,23 @@ def _waiting_east_of_a_holder(others=()):
     return guard, waits, holder
 
 
+def test_a_guard_that_keeps_its_route_samples_decides_as_a_fresh_guard_after_a_replan():
+    """The guard samples its route once per route (``Passages.route_cells``): after the
+    route changes, it must decide on the new route, not on the samples of the old."""
+    costmap = Costmap.build(parse_text_grid(two_rooms(3), resolution=0.5), WIDE)
+    config = DwaConfig(max_speed=1.0, max_accel=0.5)
+    kept = TrafficGuard(costmap, config)
+    east = kept.decide("x", 1, (4.5, MID), EASTWARD, [], stalled=False)
+    assert east.intent.passage is not None
+    westward = [(15.5, MID), (2.0, MID)]  # replanned: back west, from the other room
+    after = kept.decide("x", 2, (15.5, MID), westward, [east.intent], stalled=False)
+    fresh = TrafficGuard(costmap, config).decide(
+        "x", 2, (15.5, MID), westward, [east.intent], stalled=False
+    )
+    assert after.intent.exit == fresh.intent.exit != east.intent.exit
+    assert after.intent.route == fresh.intent.route == [[15.5, MID], [2.0, MID]]
+
+
 def test_no_waiting_place_within_a_safety_distance_of_a_parked_agv():
     """An AGV that arrived at its goal beside a 1 m door stood where the rule then sent the
     next one to wait, and that one circled the parked body for 10 s (traffic_bench door
