@@ -102,8 +102,10 @@ class Outputs:
         if self._server is None:
             return
         self.stream.flush(timeout_sec=FLUSH_TIMEOUT)
-        print("serving; Ctrl-C to stop", file=self._notify, flush=True)
+        # a stop once the notice is out is a stop, even one that comes while the print
+        # still returns (a test saw 130, "interrupted", for a SIGTERM sent on the notice)
         with suppress(KeyboardInterrupt):
+            print("serving; Ctrl-C to stop", file=self._notify, flush=True)
             self._server.wait()
 
 
