@@ -11,7 +11,12 @@ at ``--sim-time`` seconds of simulated time. Reported per fleet size:
   forked, connected and answering);
 - memory: the proportional set size (PSS, from /proc/PID/smaps_rollup: shared
   pages split between the processes that share them) of the AGV host and its
-  AGV processes, per AGV, and of the world (this process), at tick 100.
+  AGV processes, per AGV, and of the world (this process), at tick 100;
+- where the CPU goes over Zenoh, in ms per tick from tick 100 to 200 (from
+  /proc/PID/task/TID/stat): the AGV processes' main threads (the step and
+  publishing its answer), their other threads (receiving and decoding the tick:
+  the subscriber's Python thread and Zenoh's), and the world process. Their sum
+  over the cores is the least time a tick can take.
 
 Targets: 50 AGVs at >= 20 ticks/s (2x real time at 10 Hz), 100 AGVs at >= 10
 ticks/s (real time), start-up of 50 AGVs < 5 s.
@@ -33,6 +38,8 @@ from fleet.scenario import load_scenario
 
 WIDTH, HEIGHT = 60, 40
 PSS_AT_TICK = 100
+CPU_FROM, CPU_TO = 100, 200  # ticks between which the CPU per tick is measured
+TICKS_PER_S = os.sysconf("SC_CLK_TCK")
 
 
 def pss_kib(pid: int) -> int:
@@ -56,6 +63,37 @@ def descendants(pid: int) -> list[int]:
                 pass
     children = [p for p, pp in parents.items() if pp == pid]
     return children + [p for p, pp in parents.items() if pp in children]
+
+
+def thread_cpu_s(pid: int) -> tuple[float, float]:
+    """CPU seconds (user + system) of a process's main thread and of its other threads
+    ((0, 0) if it is gone)."""
+    main = other = 0.0
+    try:
+        tids = os.listdir(f"/proc/{pid}/task")
+    except OSError:
+        return 0.0, 0.0
+    for tid in tids:
+        try:
+            with open(f"/proc/{pid}/task/{tid}/stat") as f:
+                fields = f.read().rsplit(")", 1)[1].split()  # the name may hold spaces
+        except OSError:
+            continue
+        seconds = (int(fields[11]) + int(fields[12])) / TICKS_PER_S
+        if tid == str(pid):
+            main += seconds
+        else:
+            other += seconds
+    return main, other
+
+
+def cpu_split(world_pid: int) -> tuple[float, float, float]:
+    """CPU seconds so far: the AGV processes' main threads, their other threads, the world."""
+    agv_main = agv_other = 0.0
+    for pid in descendants(world_pid):
+        main, other = thread_cpu_s(pid)
+        agv_main, agv_other = agv_main + main, agv_other + other
+    return agv_main, agv_other, sum(thread_cpu_s(world_pid))
 
 
 def warehouse_grid() -> str:
@@ -99,6 +137,7 @@ class Clock:
         self.first = self.last = None
         self.ticks = 0
         self.world_pss = self.agvs_pss = 0
+        self.cpu: dict[int, tuple[float, float, float]] = {}
 
     def __call__(self, world) -> None:
         now = time.monotonic()
@@ -109,6 +148,17 @@ class Clock:
         if world.tick == PSS_AT_TICK:
             self.world_pss = pss_kib(os.getpid())
             self.agvs_pss = sum(pss_kib(p) for p in descendants(os.getpid()))
+        if world.tick in (CPU_FROM, CPU_TO):
+            self.cpu[world.tick] = cpu_split(os.getpid())
+
+    @property
+    def cpu_ms_per_tick(self) -> tuple[float, ...] | None:
+        """AGV main threads, AGV other threads, world: ms of CPU per tick (None: the run
+        ended before ``CPU_TO``)."""
+        if CPU_TO not in self.cpu:
+            return None
+        span = CPU_TO - CPU_FROM
+        return tuple((b - a) * 1e3 / span for a, b in zip(self.cpu[CPU_FROM], self.cpu[CPU_TO]))
 
     @property
     def ticks_per_s(self) -> float:
@@ -152,6 +202,15 @@ def main() -> None:
                 f"{bus.agvs_pss / size / 1024:>11.1f}  {bus.world_pss / 1024:>9.1f}  "
                 f"{arrived}/{size} arrived by {args.sim_time:g} s, {summary.collisions} collisions"
             )
+            if bus.cpu_ms_per_tick is not None:
+                steps, receiving, world = bus.cpu_ms_per_tick
+                total = steps + receiving + world
+                print(
+                    f"{'':>5}  CPU per tick over Zenoh (ticks {CPU_FROM}-{CPU_TO}): AGV main "
+                    f"threads {steps:.1f} ms ({steps / size:.2f} per AGV), AGV receiving "
+                    f"{receiving:.1f} ms, world {world:.1f} ms; {total:.1f} ms on "
+                    f"{os.cpu_count()} cores: at most {1e3 * os.cpu_count() / total:.1f} ticks/s"
+                )
             for agvs, target in ((50, 20), (100, 10)):
                 if size == agvs:
                     verdicts.append(
