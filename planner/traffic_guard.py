@@ -87,8 +87,9 @@ class TrafficGuard:
         self._ahead = 0  # AGVs queued before it on its side when its waiting place was chosen
         self._parked: list[tuple[float, float, float]] = []
         self._waiting: list[tuple[float, float, float]] = []  # other AGVs held, last tick
-        self._route: list[Point] = []  # the route of the last tick, its samples and the
-        self._route_cells: RouteCells | None = None  # part of it an intent shares
+        # the route of the last tick, sampled, and the part of it an intent shares
+        self._route: list[Point] = []
+        self._route_cells: RouteCells | None = None
         self._shared_ahead: list[list[float]] = []
 
     def park(self, discs) -> None:
