@@ -345,7 +345,20 @@ def lower_by_discs(xs, ys, clearance, moving, dt, radius):
 
 def sample_reach(pose: Pose, xs: np.ndarray, ys: np.ndarray) -> float:
     """How far from ``pose`` the samples' trajectories (N, K) reach."""
-    return math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
+    return math.sqrt(_largest_square_distance(xs, ys, float(pose[0]), float(pose[1])))
+
+
+@numba.njit(cache=True)
+def _largest_square_distance(xs, ys, x0, y0):
+    """The largest (x - x0)² + (y - y0)² over the trajectories, in one pass (numpy's four
+    (N, K) temporaries were 5 % of a 40-AGV stress case's planning time); the same
+    operations, so the same value."""
+    largest = -np.inf
+    for n in range(xs.shape[0]):
+        for k in range(xs.shape[1]):
+            dx, dy = xs[n, k] - x0, ys[n, k] - y0
+            largest = max(largest, dx * dx + dy * dy)
+    return largest
 
 
 def relevant_discs(

@@ -18,6 +18,7 @@ from planner.dwa import (
     on_route,
     rollout,
     route_offsets,
+    sample_reach,
     static_clearance,
     step_pose,
     window,
@@ -141,6 +142,16 @@ def test_the_windows_turn_rates_roll_out_as_a_search_for_them_would(command):
         rollout(pose, samples.commands, CFG.dt, CFG.steps, samples),
         rollout(pose, samples.commands, CFG.dt, CFG.steps),
     )
+
+
+def test_sample_reach_is_the_farthest_trajectory_point_as_numpy_computes_it():
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        xs = rng.normal(size=(int(rng.integers(1, 400)), 30)) * rng.choice([0.1, 3.0, 50.0])
+        ys = rng.normal(size=xs.shape)
+        pose = (float(rng.normal()), float(rng.normal()), 0.0)
+        expected = math.sqrt(float(((xs - pose[0]) ** 2 + (ys - pose[1]) ** 2).max()))
+        assert sample_reach(pose, xs, ys) == expected
 
 
 # --- clearance and admissibility ------------------------------------------------------------
