@@ -71,7 +71,7 @@ from planner.yielding import (
     YIELD_SLACK,
     agvs_of,
     parked_clearance,
-    walker_near,
+    walker_coming,
     yield_horizon,
 )
 
@@ -673,8 +673,9 @@ class DwaPlanner:
             change = jerk(commands[ok], command, command if previous is None else previous)
             speeds = np.hypot(commands[ok, 0], commands[ok, 1])
             current = math.hypot(command[0], command[1])
-            # near a walker the AGV keeps the room to yield: no speeding up out of the tolerance
-            step = math.inf if walker_near(pose, walkers) else cfg.v_resolution
+            # with a walker coming the AGV keeps the room to yield: no speeding up out of the
+            # tolerance
+            step = math.inf if walker_coming(pose, walkers) else cfg.v_resolution
             pick = steady_choice(g, change, self.behaviour.steady_tolerance, speeds, current, step)
             best = ok[pick]
         else:

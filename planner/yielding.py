@@ -129,17 +129,36 @@ def parked_clearance(
 
 WALKER_RANGE = 12.0
 """m: with a walker this near, the AGV leaves the room to yield: no straight approach to a
-tight corner (``planner.tight_turns``), no speeding up out of a steady choice (DWA). A
-walker at 1 m/s and an AGV at 2 m/s close 12 m in 4 s, about the yield horizon at
-Table 1's limits (nav_bench: 4, 6, 8 m left 2, 2, 1 collisions; 12 m, 1)."""
+tight corner (``planner.tight_turns``), no speeding up out of a steady choice (DWA) while
+it is not walking away. A walker at 1 m/s and an AGV at 2 m/s close 12 m in 4 s, about
+the yield horizon at Table 1's limits (nav_bench: 4, 6, 8 m left 2, 2, 1 collisions;
+12 m, 1)."""
+
+
+def _walkers_in_range(pose, walkers) -> np.ndarray:
+    """The rows [x, y, vx, vy, r] of ``walkers`` within ``WALKER_RANGE`` of ``pose``."""
+    if walkers is None or not len(walkers):
+        return np.zeros((0, 5))
+    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+    return walkers[np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE]
 
 
 def walker_near(pose, walkers) -> bool:
     """Whether a walker (rows [x, y, vx, vy, r]) is within ``WALKER_RANGE`` of ``pose``."""
-    if walkers is None or not len(walkers):
-        return False
-    walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
-    return bool((np.hypot(walkers[:, 0] - pose[0], walkers[:, 1] - pose[1]) < WALKER_RANGE).any())
+    return len(_walkers_in_range(pose, walkers)) > 0
+
+
+def walker_coming(pose, walkers) -> bool:
+    """Whether a walker within ``WALKER_RANGE`` of ``pose`` is not walking away from it.
+
+    One that walks away has passed, or never came: an AGV that let it by from a bay and
+    kept crawling there (the steady choice, with no speeding up near a walker) was still
+    in the bay 1 s later when the walker turned off the route into it (nav_bench seed 40).
+    A standing walker counts as coming: it may start towards the AGV at any time.
+    """
+    near = _walkers_in_range(pose, walkers)
+    away = (near[:, 0] - pose[0]) * near[:, 2] + (near[:, 1] - pose[1]) * near[:, 3] > 0.0
+    return bool((~away).any())
 
 
 def agvs_of(moving, walkers) -> np.ndarray:

@@ -125,9 +125,10 @@ def test_the_evasive_fallback_flees_past_walls_it_can_still_brake_for():
 
 @pytest.mark.parametrize(
     "seed",
-    [3, 42, 50],
+    [3, 40, 42, 50],
     ids=[
         "realistic-walker-turning-aside-among-walls",
+        "head-on-walker-turning-off-into-the-bay-the-agv-let-it-by-from",
         "head-on-walker-through-a-one-cell-gap",
         "walker-standing-on-the-route-then-walking-at-the-agv",
     ],
