@@ -63,7 +63,7 @@ import numba
 import numpy as np
 
 from planner.distance_field import DistanceField, lookup
-from planner.evasion import contact_times, evasive_index
+from planner.evasion import contact_times, evasive_index, into_wall
 from planner.lane_speed import ROUTE_TOLERANCE, braking_room, node_room, stop_room
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
 from planner.no_retreat import retreating
@@ -591,6 +591,7 @@ class DwaPlanner:
             xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
         )
         static_best = float(clearance.max())
+        walls = clearance  # each sample's least clearance to the map (the discs lower a copy)
         braking = None
         if lane_room is not None and segment is not None:
             stop_at = target_xy if stop else None
@@ -638,7 +639,8 @@ class DwaPlanner:
                     *field.origin,
                 )  # fmt: skip
                 speeds = np.hypot(commands[:, 0], commands[:, 1])
-                best = evasive_index(*times, speeds, cfg.max_accel, cfg.dt)
+                here = float(field.distance_at(pose[0], pose[1])) - cfg.radius
+                best = evasive_index(*times, into_wall(walls, here), speeds, cfg.max_accel, cfg.dt)
                 chosen = tuple(float(v) for v in commands[best])
                 path = (xs[best], ys[best], thetas[best])
                 return DwaResult(chosen, _poses(path), len(commands), 0)

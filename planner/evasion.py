@@ -53,16 +53,32 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0
     return static_first, moving_first, lowest
 
 
+WALL_SLACK = 0.01
+"""m: a sample that keeps this near its start's clearance to the walls does not go into them
+(the distance field's interpolation wobbles along a wall the AGV touches)."""
+
+
+def into_wall(walls: np.ndarray, here: float) -> np.ndarray:
+    """(N,) whether each sample, with ``walls`` its least clearance to the map over the
+    horizon, goes into a wall: below zero, and below ``here``, the clearance where the AGV
+    stands (a wall it already touches it may slide along, not press into)."""
+    return walls < min(here, 0.0) - WALL_SLACK
+
+
 def evasive_index(
     static_first: np.ndarray, moving_first: np.ndarray, lowest: np.ndarray,
-    speeds: np.ndarray, max_accel: float, dt: float,
+    entering: np.ndarray, speeds: np.ndarray, max_accel: float, dt: float,
 ) -> int:  # fmt: skip
-    """The sample that does not commit the AGV to a wall, then meets a moving disc last, then
-    keeps most clearance.
+    """The sample that does not go into a wall (``entering``), then does not commit the AGV
+    to one, then meets a moving disc last, then keeps most clearance.
 
     A wall met later than the AGV can brake for (twice its braking time, plus a cycle) is
     no threat: the next cycle chooses again. Ranking every wall contact first would keep
     the AGV creeping, in reach of the walker it is fleeing, wherever it has walls around.
+    But once a walker has pinned the AGV against a wall, every sample touches one at
+    once; the lowest clearance alone (a walker overlapping the AGV by 0.37 m outweighs a
+    wall) then drove it 0.3 m into the corner where two wall cells meet (nav_bench seed
+    282), which no vehicle can do: those samples come last.
     """
     committed = static_first <= 2.0 * speeds / max_accel + dt
-    return int(np.lexsort((-lowest, -moving_first, committed))[0])
+    return int(np.lexsort((-lowest, -moving_first, committed, entering))[0])

@@ -46,19 +46,61 @@ def clearance_at(field: DistanceField, discs: np.ndarray | None, x: float, y: fl
     return gap
 
 
+def _gradient(distance, x: float, y: float, h: float) -> tuple[float, float] | None:
+    """Unit direction in which ``distance(x, y)`` grows fastest (central differences over
+    ``h``); None where it is flat."""
+    gx = distance(x + h, y) - distance(x - h, y)
+    gy = distance(x, y + h) - distance(x, y - h)
+    norm = math.hypot(gx, gy)
+    return None if norm < 1e-9 else (gx / norm, gy / norm)
+
+
 def away_from_obstacles(
-    field: DistanceField, pose: Pose, discs: np.ndarray | None = None
+    field: DistanceField, pose: Pose, discs: np.ndarray | None = None, radius: float = 0.0
 ) -> tuple[float, float]:
     """Unit world-frame direction in which the distance to the nearest obstacle (walls, and
-    the discs if given) grows fastest."""
-    h = field.spacing
+    the discs if given) grows fastest, kept off the walls (``off_walls``) for a body of
+    ``radius``; (0, 0) where there is no such way."""
     x, y = pose[0], pose[1]
-    gx = clearance_at(field, discs, x + h, y) - clearance_at(field, discs, x - h, y)
-    gy = clearance_at(field, discs, x, y + h) - clearance_at(field, discs, x, y - h)
-    norm = math.hypot(float(gx), float(gy))
-    if norm < 1e-9:
-        return (-math.cos(pose[2]), -math.sin(pose[2]))  # flat: straight back
-    return (float(gx) / norm, float(gy) / norm)
+    away = _gradient(lambda px, py: clearance_at(field, discs, px, py), x, y, field.spacing)
+    if away is None:
+        away = (-math.cos(pose[2]), -math.sin(pose[2]))  # flat: straight back
+    return off_walls(field, x, y, away, radius)
+
+
+def off_walls(
+    field: DistanceField, x: float, y: float, direction: tuple[float, float], radius: float
+) -> tuple[float, float]:
+    """``direction`` from (x, y), less its part into a wall a body of ``radius`` would press
+    against; (0, 0) when nothing is left (a corner).
+
+    Away from a walker that stands on the AGV is often into a wall: nav_bench seed 282's
+    back-off drove 0.3 m into the corner where two wall cells meet. Discs give way or are
+    merely predicted; a wall does not.
+    """
+
+    def wall(px: float, py: float) -> float:
+        return float(field.distance_at(px, py))
+
+    h = field.spacing
+    here = wall(x, y)
+    floor = min(radius, here)  # as near as the body may come: touching, or where it is
+
+    def presses(u) -> bool:
+        return wall(x + u[0] * h, y + u[1] * h) < floor - 1e-9
+
+    if not presses(direction):
+        return direction
+    normal = _gradient(wall, x, y, h)
+    if normal is None:
+        return (0.0, 0.0)
+    into = direction[0] * normal[0] + direction[1] * normal[1]
+    tx, ty = direction[0] - into * normal[0], direction[1] - into * normal[1]
+    norm = math.hypot(tx, ty)
+    if norm < 1e-6:
+        return (0.0, 0.0)
+    along = (tx / norm, ty / norm)
+    return (0.0, 0.0) if presses(along) else along
 
 
 def recovery_command(
@@ -70,9 +112,9 @@ def recovery_command(
     frame, so an omnidirectional AGV needs no turn), ``rotate`` turns in place at the
     highest rate."""
     if kind == "back off":
-        ux, uy = away_from_obstacles(field, pose, discs)
+        ux, uy = away_from_obstacles(field, pose, discs, config.radius)
         c, s = math.cos(pose[2]), math.sin(pose[2])
-        speed = min(BACK_OFF_SPEED, config.max_speed)
+        speed = min(BACK_OFF_SPEED, config.max_speed) if (ux or uy) else 0.0
         vx, vy = speed * (ux * c + uy * s), speed * (-ux * s + uy * c)
         wanted = (max(vx, config.min_vx), vy, 0.0)
     elif kind == "rotate":

@@ -26,7 +26,7 @@ from fleet.scenario import (
 )
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner, step_pose
-from planner.evasion import contact_times, evasive_index
+from planner.evasion import contact_times, evasive_index, into_wall
 from planner.fusion import FusionConfig, FusionController
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
@@ -120,7 +120,23 @@ def test_the_evasive_fallback_flees_past_walls_it_can_still_brake_for():
     moving_first = np.array([0.5, np.inf, np.inf])
     lowest = np.array([-0.1, 0.0, -0.2])
     speeds = np.array([0.02, 0.2, 0.5])
-    assert evasive_index(static_first, moving_first, lowest, speeds, 0.2, 0.1) == 1
+    entering = np.zeros(3, dtype=bool)
+    assert evasive_index(static_first, moving_first, lowest, entering, speeds, 0.2, 0.1) == 1
+
+
+def test_the_evasive_fallback_never_presses_into_a_wall_it_is_pinned_against():
+    # the AGV touches a wall, a walker overlapping it: [fleeing the walker into the wall,
+    # sliding along the wall, standing]; each touches the wall at once
+    walls = np.array([-0.3, -0.005, 0.0])
+    entering = into_wall(walls, 0.0)
+    assert entering.tolist() == [True, False, False]
+    static_first = np.full(3, 0.1)
+    moving_first = np.full(3, 0.1)
+    lowest = np.array([-0.3, -0.35, -0.37])  # fleeing into the wall gains most from the walker
+    speeds = np.array([0.2, 0.1, 0.0])
+    assert evasive_index(static_first, moving_first, lowest, entering, speeds, 0.2, 0.1) == 1
+    assert not into_wall(np.array([-0.2]), -0.2).any()  # already in one: no deeper is fine
+    assert into_wall(np.array([-0.25]), -0.2).all()
 
 
 @pytest.mark.parametrize(
@@ -394,6 +410,27 @@ def test_backing_off_moves_away_from_a_standing_walker_not_only_from_the_walls()
     walker = np.array([[5.0, 2.2, 0.0, 0.0, 0.35]])
     assert away_from_obstacles(field, pose)[1] > 0.9  # the walls alone: north, at the walker
     assert away_from_obstacles(field, pose, walker)[1] < 0
+
+
+def test_backing_off_from_a_walker_that_pins_the_agv_into_a_corner_never_presses_into_it():
+    # two wall cells meeting at the corner (2, 1); the AGV touches both, a walker standing
+    # on it from the north-west: away from the walker is into the corner (nav_bench seed
+    # 282's back-off drove 0.3 m into it)
+    field = DistanceField.from_grid(parse_text_grid("\n".join(["....", "..#.", ".#.."])))
+    pose = (1.7, 1.3, 0.0)
+    walker = np.array([[1.5, 1.5, 0.0, 0.0, 0.35]])
+    ux, uy = away_from_obstacles(field, pose, walker)  # a point body: straight into it
+    assert ux > 0.5 and uy < -0.5
+    ux, uy = away_from_obstacles(field, pose, walker, radius=0.3)
+    step = field.spacing
+    assert float(field.distance_at(1.7 + ux * step, 1.3 + uy * step)) >= 0.3 - 1e-9
+    # along one wall and off the other: the way out of a wall the body merely touches
+    pose = (1.5, 1.3, 0.0)  # on the south wall, 0.5 m from the east one
+    walker = np.array([[1.3, 1.75, 0.0, 0.0, 0.35]])  # on it from the north-west
+    assert away_from_obstacles(field, pose, walker)[1] < -0.5  # south-east, into the wall
+    assert away_from_obstacles(field, pose, walker, radius=0.3) == pytest.approx((1.0, 0.0))
+    walker = np.array([[1.5, 1.75, 0.0, 0.0, 0.35]])  # from straight north: only into it
+    assert away_from_obstacles(field, pose, walker, radius=0.3) == (0.0, 0.0)
 
 
 def test_a_waiting_place_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
