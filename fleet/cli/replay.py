@@ -7,7 +7,7 @@ import sys
 
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError, positive_float
-from fleet.runtime.launcher import sigterm_as_interrupt
+from fleet.runtime.interrupts import interrupts_raised
 from recordings.reader import RecordingError, open_recording
 from recordings.rerun_view import require_display, save_rrd, serve_web, spawn_viewer
 
@@ -75,7 +75,7 @@ def replay(args: argparse.Namespace) -> int:
     if args.save:
         save_rrd(recording, args.save, follow=args.follow)
         print(f"agv-fleet replay: wrote {args.save}", file=sys.stderr)
-    with sigterm_as_interrupt():
+    with interrupts_raised():
         if args.web:
             serve_web(recording, rate=args.rate, follow=args.follow, port=args.port)
         elif viewer:

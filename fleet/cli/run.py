@@ -12,6 +12,7 @@ from pathlib import Path
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError, non_negative_float, positive_float
 from fleet.runtime.inprocess import run_in_process, run_recorded
+from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.launcher import FleetOptions, RecordingLost, run_fleet
 from fleet.runtime.progress import Progress
 from fleet.runtime.summary import summarize
@@ -130,6 +131,7 @@ def run(args: argparse.Namespace) -> int:
     watch = _Watch(None if args.quiet else Progress(scenario))
     with ExitStack() as stack:
         try:
+            stack.enter_context(interrupts_raised())
             view = None
             if args.rerun:
                 view = stack.enter_context(

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import tempfile
@@ -30,6 +29,7 @@ from pathlib import Path
 from bridge.bus import Bus
 from bridge.session import fresh_endpoint, new_run_id, open_router, run_prefix
 from bridge.trust import CREDENTIALS_ENV, write_run_credentials
+from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
 from fleet.runtime.world_server import WorldServer
@@ -96,7 +96,7 @@ def run_fleet(
     run_dir = tempfile.mkdtemp(prefix="agv-fleet-")  # 0700: this user's only
     endpoint = fresh_endpoint(options.transport, run_dir)
     children: list[subprocess.Popen] = []
-    with _children_ended(children), sigterm_as_interrupt():
+    with _children_ended(children), interrupts_raised():
         try:
             names = [agv.name for agv in scenario.agvs]
             guard, child_files = write_run_credentials(run_dir, names, prefix)
@@ -222,17 +222,3 @@ def _children_ended(children: list[subprocess.Popen]):
             except subprocess.TimeoutExpired:
                 child.kill()
                 child.wait()
-
-
-@contextmanager
-def sigterm_as_interrupt():
-    """SIGTERM ends the run like Ctrl-C, so the children are cleaned up."""
-
-    def handler(signum, frame):
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)

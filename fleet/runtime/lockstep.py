@@ -19,6 +19,7 @@ from typing import Protocol
 
 from bridge import keys
 from bridge.messages import AgvCommand, ResultMsg, Tick
+from fleet.runtime.interrupts import raise_if_interrupted
 from fleet.runtime.summary import RunSummary, summarize
 from fleet.runtime.world import World, map_message
 
@@ -53,6 +54,7 @@ def run_lockstep(
     outbox(keys.WORLD_MAP, map_message(world.scenario.grid))
     tick = world.first_tick()
     while tick is not None:
+        raise_if_interrupted()
         outbox(keys.WORLD_TICK, tick)
         tick = world.advance(collect(tick, world))
         for event in world.drain_events():

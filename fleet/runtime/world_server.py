@@ -21,6 +21,7 @@ from collections.abc import Callable
 from bridge import keys
 from bridge.bus import Bus
 from bridge.messages import AgvCommand, Tick
+from fleet.runtime.interrupts import raise_if_interrupted
 from fleet.runtime.lockstep import run_lockstep
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
@@ -111,6 +112,7 @@ class WorldServer:
             if not recorder_up:
                 with contextlib.suppress(queue.Empty):
                     recorder_up = self._recorder.get_nowait()[1]
+            raise_if_interrupted()
             problem = self.abort_check() if self.abort_check else None
             if problem:
                 raise FleetStartError(problem)
@@ -143,6 +145,7 @@ class WorldServer:
         wanted = tick.tick + 1
         started = sent = time.monotonic()
         while True:
+            raise_if_interrupted()
             self._update_liveliness()
             waiting = [n for n in self.world.live_agvs() if n not in replies]
             if not waiting:

@@ -1,0 +1,56 @@
+"""An interrupt that Python drops still ends the run.
+
+CI once saw Ctrl-C arrive while numba's compiler was freeing an LLVM object in a
+``__del__``: the ``KeyboardInterrupt`` was printed as "Exception ignored in ..."
+and the run went on to its end. ``_FinalizerInterrupted`` reproduces that: it is
+sent Ctrl-C while it is being finalized.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import pytest
+
+from fleet.runtime.interrupts import interrupts_raised, raise_if_interrupted
+from fleet.runtime.launcher import FleetOptions, run_fleet
+from fleet.scenario import load_scenario
+
+pytestmark = pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+
+
+class _FinalizerInterrupted:
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(100_000):  # the handler runs here, inside __del__, and is dropped
+            pass
+
+
+def _drop_an_interrupt() -> None:
+    try:
+        _FinalizerInterrupted()
+    except KeyboardInterrupt:  # not dropped: this Python delivers it; the test is moot
+        pytest.fail("the interrupt was raised outside the finalizer")
+
+
+def test_an_interrupt_dropped_in_a_finalizer_is_raised_by_the_next_check():
+    with interrupts_raised():
+        _drop_an_interrupt()
+        with pytest.raises(KeyboardInterrupt):
+            raise_if_interrupted()
+    raise_if_interrupted()  # outside, the interrupt is forgotten: no raise
+
+
+def test_a_fleet_run_interrupted_inside_a_finalizer_ends_within_a_tick():
+    seen: list[float] = []
+
+    def progress(world) -> None:
+        seen.append(world.time)
+        if len(seen) == 10:
+            _drop_an_interrupt()
+
+    scenario = load_scenario("corridor")
+    with pytest.raises(KeyboardInterrupt):
+        run_fleet(scenario, FleetOptions(scenario_arg="corridor"), progress=progress)
+    assert len(seen) == 10  # no tick after the interrupt
