@@ -112,16 +112,37 @@ def recovery_command(
     frame, so an omnidirectional AGV needs no turn), ``rotate`` turns in place at the
     highest rate."""
     if kind == "back off":
-        ux, uy = away_from_obstacles(field, pose, discs, config.radius)
-        c, s = math.cos(pose[2]), math.sin(pose[2])
-        speed = min(BACK_OFF_SPEED, config.max_speed) if (ux or uy) else 0.0
-        vx, vy = speed * (ux * c + uy * s), speed * (-ux * s + uy * c)
-        wanted = (max(vx, config.min_vx), vy, 0.0)
+        wanted = (*_backing(config, field, pose, discs), 0.0)
     elif kind == "rotate":
         wanted = (0.0, 0.0, config.max_omega)
     else:
         wanted = (0.0, 0.0, 0.0)
     return towards(config, command, wanted)
+
+
+def _backing(config: DwaConfig, field: DistanceField, pose: Pose, discs) -> tuple[float, float]:
+    """The body-frame (vx, vy) of backing off: away from the nearest obstacle, off the walls,
+    and no slower than ``min_vx`` allows. Where that floor cuts off part of the way back,
+    what is left must still keep off the walls, or the AGV stands: an AGV that cannot
+    reverse and faces a shelf kept only the sideways part of "back along the shelf", and
+    that pressed it into the shelf (traffic suite warehouse-40 n40 s1, agv29)."""
+    ux, uy = away_from_obstacles(field, pose, discs, config.radius)
+    if not (ux or uy):
+        return (0.0, 0.0)
+    speed = min(BACK_OFF_SPEED, config.max_speed)
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    vx, vy = speed * (ux * c + uy * s), speed * (-ux * s + uy * c)
+    if vx >= config.min_vx:
+        return (vx, vy)
+    vx = config.min_vx
+    wx, wy = vx * c - vy * s, vx * s + vy * c  # what is left, in the world frame
+    norm = math.hypot(wx, wy)
+    if norm < 1e-9:
+        return (0.0, 0.0)
+    left = (wx / norm, wy / norm)
+    if off_walls(field, pose[0], pose[1], left, config.radius) != left:
+        return (0.0, 0.0)
+    return (vx, vy)
 
 
 def is_stopped(command: Command | np.ndarray, tolerance: float = 1e-6) -> bool:

@@ -32,7 +32,7 @@ from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
 from planner.parked_discs import blocking_cells, covered_cells
-from planner.recovery import away_from_obstacles
+from planner.recovery import away_from_obstacles, recovery_command
 from planner.route_check import blocked_point
 
 DATA = Path(__file__).parent / "data"
@@ -431,6 +431,27 @@ def test_backing_off_from_a_walker_that_pins_the_agv_into_a_corner_never_presses
     assert away_from_obstacles(field, pose, walker, radius=0.3) == pytest.approx((1.0, 0.0))
     walker = np.array([[1.5, 1.75, 0.0, 0.0, 0.35]])  # from straight north: only into it
     assert away_from_obstacles(field, pose, walker, radius=0.3) == (0.0, 0.0)
+
+
+@pytest.mark.parametrize("reverses", [False, True], ids=["forward-only", "reversing"])
+def test_backing_off_along_a_shelf_it_faces_never_presses_into_it(reverses):
+    # traffic suite warehouse-40 n40 s1, agv29: touching a shelf to the north and facing it
+    # (north-west), an AGV met at its side; back along the shelf needs reversing, and an
+    # AGV that cannot reverse kept only the sideways part, which pressed it into the shelf
+    field = DistanceField.from_grid(parse_text_grid("########\n........\n........"))
+    config = replace(DwaConfig(), min_vx=-DwaConfig().max_speed if reverses else 0.0)
+    pose = (4.0, 1.7, 2.26)
+    other = np.array([[3.4, 1.75, 0.0, 0.0, 0.35]])
+    command = (0.0, 0.0, 0.0)
+    for _ in range(20):
+        command = recovery_command("back off", config, field, pose, command, other)
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    east, north = command[0] * c - command[1] * s, command[0] * s + command[1] * c
+    assert north <= 1e-9  # never into the shelf
+    if reverses:
+        assert east > 0.2  # backs off along it, away from the other AGV
+    else:
+        assert command == (0.0, 0.0, 0.0)  # nothing is left: it stands
 
 
 def test_a_waiting_place_behind_an_agv_that_cannot_reverse_is_turned_to_on_the_spot():
