@@ -66,7 +66,7 @@ from planner.distance_field import DistanceField, lookup
 from planner.evasion import contact_times, evasive_index, into_wall
 from planner.lane_speed import ROUTE_TOLERANCE, braking_room, node_room, stop_room
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
-from planner.no_retreat import retreating
+from planner.no_retreat import ahead_on_route, retreating
 from planner.yielding import (
     YIELD_SLACK,
     agvs_of,
@@ -621,7 +621,8 @@ class DwaPlanner:
             braking = np.maximum(braking, clearance)
         mask = admissible_mask(cfg, commands, clearance, braking)
         if self.behaviour.no_retreat and len(agvs_of(lowering, walkers)):
-            mask &= ~retreating(pose, xs[:, -1], ys[:, -1], target_xy)
+            ahead = ahead_on_route(pose, target_xy, segment)
+            mask &= ~retreating(pose, xs[:, -1], ys[:, -1], ahead)
         if self.behaviour.yield_early and walkers is not None and len(walkers):
             ends = (xs[:, -1], ys[:, -1])
             walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)

@@ -13,6 +13,12 @@ points away from the target by more than ``RETREAT_ANGLE`` are dropped; with
 nothing else admissible the AGV brakes (as DWA does when only AGVs are in reach,
 ``DwaPlanner._evade_from``). Walkers do not plan: from them the AGV still backs
 off (``planner.yielding``).
+
+"Away" is measured from where the route goes on (``ahead_on_route``), not from the
+target as the crow flies: an AGV pushed off its route into a side aisle, with its
+target beyond a shelf, otherwise counted driving on down that aisle as a step
+aside (warehouse-40 n40 s4: agv22 fled 3 m down its side aisle, came back and
+crossed its own path five times).
 """
 
 from __future__ import annotations
@@ -28,6 +34,28 @@ from it (a step straight aside, 90 degrees, is not a retreat)."""
 STANDING = 0.1
 """m: a displacement over the horizon shorter than this (braking, turning on the spot) is
 no retreat."""
+
+
+LOOKAHEAD = 3.0
+"""m: how far along the route segment, beyond the AGV's projection on it, "ahead" lies
+(long enough that an AGV stepping aside by up to half an aisle still counts a step
+straight aside as no retreat)."""
+
+
+def ahead_on_route(pose, target, segment) -> tuple[float, float]:
+    """The point ``LOOKAHEAD`` beyond ``pose``'s projection on the route ``segment``
+    (its start, its end ``target``), clamped to the segment; the target itself
+    without a segment."""
+    if segment is None:
+        return target
+    (ax, ay), (bx, by) = segment
+    dx, dy = bx - ax, by - ay
+    length = math.hypot(dx, dy)
+    if length < 1e-9:
+        return target
+    along = ((pose[0] - ax) * dx + (pose[1] - ay) * dy) / length
+    s = min(max(along + LOOKAHEAD, 0.0), length) / length
+    return (ax + s * dx, ay + s * dy)
 
 
 def retreating(pose, end_x: np.ndarray, end_y: np.ndarray, target) -> np.ndarray:

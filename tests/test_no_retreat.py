@@ -14,7 +14,7 @@ from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner
 from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
-from planner.no_retreat import retreating
+from planner.no_retreat import ahead_on_route, retreating
 
 CONFIG = DwaConfig(
     max_speed=1.0, max_accel=0.5, max_omega=math.radians(60), max_alpha=math.radians(120)
@@ -34,6 +34,27 @@ def test_a_step_straight_aside_or_standing_is_no_retreat_driving_back_is():
     assert not _retreats(pose, (-0.05, 0.0), target)  # braking: hardly moved
     assert _retreats(pose, (-0.5, 0.5), target)  # 135 degrees off the target
     assert _retreats(pose, (-1.0, 0.0), target)
+
+
+def test_away_counts_from_where_the_route_goes_on_not_from_the_target_beyond_a_shelf():
+    """warehouse-40 n40 s4's agv22: pushed 1.7 m down a side aisle below the cross aisle
+    its route follows west, its target 20 m west beyond a shelf."""
+    pose, target = (25.5, 13.8, 0.0), (5.875, 15.625)
+    ahead = ahead_on_route(pose, target, ((25.25, 15.5), target))
+    down_the_aisle, back_up = (25.5, 12.8), (25.5, 14.8)
+    assert not _retreats(pose, down_the_aisle, target)  # aside from the target as the crow flies
+    assert _retreats(pose, down_the_aisle, ahead)
+    assert not _retreats(pose, back_up, ahead)
+
+
+def test_on_the_route_a_step_straight_aside_is_still_no_retreat():
+    target = (0.0, 0.0)
+    segment = ((20.0, 0.0), target)
+    for offset in (0.0, 0.5):  # on the route, and already half an aisle aside
+        pose = (10.0, offset, 0.0)
+        assert not _retreats(pose, (10.0, offset + 1.0), ahead_on_route(pose, target, segment))
+    pose = (1.0, 0.0, 0.0)  # near the end the target itself is ahead
+    assert ahead_on_route(pose, target, segment) == target
 
 
 def _head_on(behaviour, walkers=None):
