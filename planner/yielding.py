@@ -127,6 +127,9 @@ def parked_clearance(
     return out
 
 
+STILL = 0.01
+"""m/s: a walker slower than this stands still."""
+
 WALKER_RANGE = 12.0
 """m: with a walker this near, the AGV leaves the room to yield: no straight approach to a
 tight corner (``planner.tight_turns``), no speeding up out of a steady choice (DWA) while
@@ -146,6 +149,12 @@ def _walkers_in_range(pose, walkers) -> np.ndarray:
 def walker_near(pose, walkers) -> bool:
     """Whether a walker (rows [x, y, vx, vy, r]) is within ``WALKER_RANGE`` of ``pose``."""
     return len(_walkers_in_range(pose, walkers)) > 0
+
+
+def walkers_standing(pose, walkers) -> bool:
+    """Whether every walker within ``WALKER_RANGE`` of ``pose`` stands still (True for none)."""
+    near = _walkers_in_range(pose, walkers)
+    return bool((np.hypot(near[:, 2], near[:, 3]) < STILL).all())
 
 
 def walker_coming(pose, walkers) -> bool:

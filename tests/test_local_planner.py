@@ -157,6 +157,17 @@ def test_nav_bench_episodes_that_once_ended_in_a_collision(seed):
     assert agv.status == "arrived" and agv.collisions == 0, agv
 
 
+def test_a_one_cell_gap_is_threaded_straight_after_a_stall_though_a_walker_stands_in_range():
+    """Held-out nav_bench seed 216: its walker stands where its walk ended, a few metres
+    away; with a walker in range the straight approach to the tight corner was off for
+    good and the run failed with no progress before a gap DWA's arcs cannot thread."""
+    from benchmarks.nav_episodes import make_episode
+
+    summary, _ = run(make_episode(216).scenario("fusion", "default"))
+    agv = summary.agvs[0]
+    assert agv.status == "arrived" and agv.collisions == 0, agv
+
+
 WALLED = "." + "#" * 3 + "." + "#" * 14 + "."  # a wall with a gap at x = 4
 CORRIDORS = parse_text_grid(
     "\n".join(["." * 20] * 3 + [WALLED] + ["." * 20] * 3 + [WALLED] + ["." * 20] * 3)

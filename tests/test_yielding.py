@@ -2,7 +2,7 @@
 
 import pytest
 
-from planner.yielding import WALKER_RANGE, walker_coming, walker_near
+from planner.yielding import WALKER_RANGE, walker_coming, walker_near, walkers_standing
 
 POSE = (5.0, 5.0, 0.0)
 
@@ -36,3 +36,11 @@ def test_near_counts_every_walker_in_range_and_none_without_walkers():
     assert walker_near(POSE, _walker(8.0, 5.0, 0.5, 0.0))
     assert not walker_near(POSE, _walker(5.0 + WALKER_RANGE + 1.0, 5.0, 0.0, 0.0))
     assert not walker_near(POSE, None) and not walker_coming(POSE, [])
+
+
+def test_standing_means_every_walker_in_range_stands_still():
+    standing, walking = _walker(8.0, 5.0, 0.0, 0.0), _walker(3.0, 5.0, 0.0, 0.4)
+    far_walking = _walker(5.0 + WALKER_RANGE + 1.0, 5.0, -1.0, 0.0)
+    assert walkers_standing(POSE, standing)
+    assert walkers_standing(POSE, standing + far_walking)  # out of range: does not count
+    assert not walkers_standing(POSE, standing + walking)
