@@ -13,6 +13,7 @@ import pytest
 
 from fleet import exit_codes
 from fleet.cli.main import main
+from recordings.reader import open_recording
 from tests.processes import agv_pid
 
 CLI = [sys.executable, "-m", "fleet.cli"]
@@ -108,6 +109,10 @@ def test_an_interrupted_run_exits_130_and_names_its_recording_and_the_state_so_f
     assert "Traceback" not in err and err.rstrip().endswith("interrupted")
     assert "so far:" in err and "left" in err and "right" in err  # the partial summary
     assert f"recorded up to the interrupt: {path}" in err and path.exists()
+    # the run ended between two ticks as any run ends: the AGVs and the recorder left on
+    # the world's word (none reports it gone) and the recording is whole
+    assert "went away" not in err and "(interrupted)" in err
+    assert open_recording(path).result["end_reason"] == "interrupted"
 
 
 def test_run_json_names_the_recording(tmp_path, capsys):

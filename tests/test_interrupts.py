@@ -8,11 +8,14 @@ sent Ctrl-C while it is being finalized.
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 
 import pytest
 
+from bridge import keys
+from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.interrupts import interrupts_raised, raise_if_interrupted
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.scenario import load_scenario
@@ -54,3 +57,21 @@ def test_a_fleet_run_interrupted_inside_a_finalizer_ends_within_a_tick():
     with pytest.raises(KeyboardInterrupt):
         run_fleet(scenario, FleetOptions(scenario_arg="corridor"), progress=progress)
     assert len(seen) == 10  # no tick after the interrupt
+
+
+def test_ctrl_c_ends_the_run_at_a_tick_with_its_final_tick_and_result_then_raises():
+    sent: list[tuple[str, object]] = []
+
+    def progress(world) -> None:
+        if world.tick == 10:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with interrupts_raised(), pytest.raises(KeyboardInterrupt):
+        run_in_process(load_scenario("corridor"), lambda k, m: sent.append((k, m)), progress)
+    ticks = [m for k, m in sent if k == keys.WORLD_TICK]
+    assert ticks[-1].final and ticks[-1].tick == 10 and not any(t.final for t in ticks[:-1])
+    assert [e.detail for k, e in sent if k == keys.WORLD_EVENT and e.kind == "end"] == [
+        "interrupted"
+    ]
+    assert sent[-1][0] == keys.WORLD_RESULT
+    assert json.loads(sent[-1][1].summary)["end_reason"] == "interrupted"

@@ -26,6 +26,7 @@ from bridge.trust import (
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError, non_negative_float, positive_float
 from fleet.runtime.agv_host import serve_agvs
+from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
 from fleet.runtime.world_server import WorldServer
@@ -161,7 +162,8 @@ def run_world(args: argparse.Namespace) -> int:
     warning = exposure_warning(args.listen, secured)
     if warning:
         print(f"agv-fleet world: {warning}", file=sys.stderr)
-    with open_router(args.listen, args.zenoh_config, guard) as session:
+    # Ctrl-C ends the run at a tick: the AGVs started by hand end on its final tick
+    with interrupts_raised(), open_router(args.listen, args.zenoh_config, guard) as session:
         server = WorldServer(
             scenario,
             Bus(session, prefix),

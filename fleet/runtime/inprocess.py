@@ -7,6 +7,7 @@ from pathlib import Path
 
 from bridge.messages import AgvCommand, Tick
 from fleet.runtime.agv_node import AgvNode, publish_output
+from fleet.runtime.interrupts import raise_if_interrupted
 from fleet.runtime.lockstep import Outbox, run_lockstep, tee
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
@@ -23,7 +24,14 @@ def run_in_process(
     outbox: Outbox | None = None,
     progress: Callable[[World], None] | None = None,
 ) -> RunSummary:
-    """Run ``scenario`` with every AGV node called directly; every message to ``outbox``."""
+    """Run ``scenario`` with every AGV node called directly; every message to ``outbox``.
+    Ctrl-C (inside ``interrupts_raised``) ends the run at a tick, then raises."""
+    summary = _run_nodes(scenario, outbox, progress)
+    raise_if_interrupted()
+    return summary
+
+
+def _run_nodes(scenario: Scenario, outbox: Outbox | None, progress) -> RunSummary:
     outbox = outbox or _discard
     nodes = {a.name: AgvNode(scenario, a.name) for a in scenario.agvs}
 
@@ -50,6 +58,7 @@ def run_recorded(
         path, scenario_name=scenario.name, scenario_text=scenario.source, run_facts=run_facts
     ) as writer:
         record = record_sink(writer, scenario.dt)
-        summary = run_in_process(scenario, tee(record, also) if also else record, progress)
+        summary = _run_nodes(scenario, tee(record, also) if also else record, progress)
         writer.finish(summary.to_json())
+    raise_if_interrupted()  # after the recording is whole: it ended "interrupted"
     return summary

@@ -7,6 +7,12 @@ there is printed as "Exception ignored in ..." and dropped, and the run goes on
 as if nobody had pressed Ctrl-C. So the handler also notes the interrupt, and
 the run's clock asks ``raise_if_interrupted()`` once a tick: a dropped
 interrupt ends the run one tick later instead of never.
+
+Inside the lockstep loop the handler raises nothing at all
+(``interrupts_deferred``): the loop ends the run between two ticks, sends the
+final tick and the result like any other end, and only then raises. The AGV
+processes and the recorder then end on the world's word, not on its
+disappearance, and the recording is a whole run that ended "interrupted".
 """
 
 from __future__ import annotations
@@ -18,12 +24,14 @@ from contextlib import contextmanager
 _SIGNALS = (signal.SIGINT, signal.SIGTERM)
 _pending = False
 _depth = 0
+_deferred = 0
 
 
 def _handler(signum, frame) -> None:
     global _pending
     _pending = True
-    raise KeyboardInterrupt
+    if not _deferred:
+        raise KeyboardInterrupt
 
 
 @contextmanager
@@ -42,6 +50,23 @@ def interrupts_raised() -> Iterator[None]:
             signal.signal(s, handler)
         if _depth == 0:
             _pending = False
+
+
+@contextmanager
+def interrupts_deferred() -> Iterator[None]:
+    """While inside (and inside ``interrupts_raised``), Ctrl-C and SIGTERM are only noted:
+    the caller asks ``interrupted()`` where it can end cleanly."""
+    global _deferred
+    _deferred += 1
+    try:
+        yield
+    finally:
+        _deferred -= 1
+
+
+def interrupted() -> bool:
+    """Whether Ctrl-C or SIGTERM came while inside ``interrupts_raised``."""
+    return _pending
 
 
 def raise_if_interrupted() -> None:

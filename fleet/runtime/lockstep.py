@@ -19,7 +19,7 @@ from typing import Protocol
 
 from bridge import keys
 from bridge.messages import AgvCommand, ResultMsg, Tick
-from fleet.runtime.interrupts import raise_if_interrupted
+from fleet.runtime.interrupts import interrupted, interrupts_deferred
 from fleet.runtime.summary import RunSummary, summarize
 from fleet.runtime.world import World, map_message
 
@@ -49,20 +49,29 @@ def run_lockstep(
     after_tick: Callable[[World], None] | None = None,
 ) -> RunSummary:
     """Run ``world`` to its end; ``after_tick(world)`` runs after every tick (progress,
-    pacing, the live view)."""
+    pacing, the live view). Ctrl-C or SIGTERM (inside ``interrupts_raised``) ends the run at
+    the tick it comes in, with its final tick and result (end reason "interrupted"); the
+    caller raises ``KeyboardInterrupt`` once the run's messages are out."""
     t0 = time.perf_counter()
     outbox(keys.WORLD_MAP, map_message(world.scenario.grid))
     tick = world.first_tick()
-    while tick is not None:
-        raise_if_interrupted()
-        outbox(keys.WORLD_TICK, tick)
-        tick = world.advance(collect(tick, world))
-        for event in world.drain_events():
-            outbox(keys.WORLD_EVENT, event)
-        if tick is None:
-            outbox(keys.WORLD_TICK, world.final_tick())
-        if after_tick:
-            after_tick(world)
+    with interrupts_deferred():
+        while tick is not None:
+            commands = {}
+            if not interrupted():
+                outbox(keys.WORLD_TICK, tick)
+                commands = collect(tick, world)
+            if interrupted():  # Ctrl-C: the run ends at this tick, as any run ends
+                world.interrupt()
+                tick = None
+            else:
+                tick = world.advance(commands)
+            for event in world.drain_events():
+                outbox(keys.WORLD_EVENT, event)
+            if tick is None:
+                outbox(keys.WORLD_TICK, world.final_tick())
+            if after_tick and not interrupted():
+                after_tick(world)
     summary = summarize(world, time.perf_counter() - t0)
     outbox(keys.WORLD_RESULT, ResultMsg(json.dumps(summary.to_json())))
     return summary

@@ -27,6 +27,8 @@ from planner.profiles import PAPER
 from planner.traffic import Intent
 from planner.traffic_guard import ROUTE_POINTS
 
+INTERRUPTED = "interrupted"  # the end reason of a run ended by Ctrl-C or SIGTERM
+
 
 @dataclass
 class AgvRecord:
@@ -198,6 +200,10 @@ class World:
         """The events since the last call (arrivals, failures, collisions, the end)."""
         events, self.events = self.events, []
         return events
+
+    def interrupt(self) -> None:
+        """End the run where it stands (Ctrl-C or SIGTERM), with the reason ``INTERRUPTED``."""
+        self._end(INTERRUPTED)
 
     def final_tick(self) -> Tick:
         """The end state of the run (after the last ``advance``)."""

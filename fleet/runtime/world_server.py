@@ -21,7 +21,7 @@ from collections.abc import Callable
 from bridge import keys
 from bridge.bus import Bus
 from bridge.messages import AgvCommand, Tick
-from fleet.runtime.interrupts import raise_if_interrupted
+from fleet.runtime.interrupts import interrupted, raise_if_interrupted
 from fleet.runtime.lockstep import run_lockstep
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
@@ -85,6 +85,7 @@ class WorldServer:
 
         summary = run_lockstep(self.world, self._collect, self.bus.publish, after_tick=after_tick)
         self._await_departures()
+        raise_if_interrupted()  # the run ended "interrupted" and everyone has left
         return summary
 
     def _await_departures(self) -> None:
@@ -144,8 +145,7 @@ class WorldServer:
         replies: dict[str, AgvCommand] = {}
         wanted = tick.tick + 1
         started = sent = time.monotonic()
-        while True:
-            raise_if_interrupted()
+        while not interrupted():  # Ctrl-C: the clock ends the run at this tick
             self._update_liveliness()
             waiting = [n for n in self.world.live_agvs() if n not in replies]
             if not waiting:
@@ -167,6 +167,7 @@ class WorldServer:
                 if command.tick == wanted and received.key == keys.agv_command(command.name):
                     replies[command.name] = command
                     self._lost.pop(command.name, None)
+        return replies
 
     def _arrived_commands(self) -> list:
         """The commands waiting (at least one, if one comes within POLL_S): taken together,
