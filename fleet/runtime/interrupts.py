@@ -5,8 +5,9 @@ that thread is doing. If it is running a finalizer at that moment (numba's
 compiler frees LLVM objects in ``__del__``), the ``KeyboardInterrupt`` raised
 there is printed as "Exception ignored in ..." and dropped, and the run goes on
 as if nobody had pressed Ctrl-C. So the handler also notes the interrupt, and
-the run's clock asks ``raise_if_interrupted()`` once a tick: a dropped
-interrupt ends the run one tick later instead of never.
+the run's clock asks ``interrupted()`` once a tick (the waits before the first
+tick ``raise_if_interrupted()``): a dropped interrupt ends the run one tick
+later instead of never.
 
 Inside the lockstep loop the handler raises nothing at all
 (``interrupts_deferred``): the loop ends the run between two ticks, sends the
