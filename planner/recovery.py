@@ -79,19 +79,9 @@ def off_walls(
     merely predicted; a wall does not.
     """
 
-    def wall(px: float, py: float) -> float:
-        return float(field.distance_at(px, py))
-
-    h = field.spacing
-    here = wall(x, y)
-    floor = min(radius, here)  # as near as the body may come: touching, or where it is
-
-    def presses(u) -> bool:
-        return wall(x + u[0] * h, y + u[1] * h) < floor - 1e-9
-
-    if not presses(direction):
+    if not presses_wall(field, x, y, direction, radius):
         return direction
-    normal = _gradient(wall, x, y, h)
+    normal = _gradient(lambda px, py: float(field.distance_at(px, py)), x, y, field.spacing)
     if normal is None:
         return (0.0, 0.0)
     into = direction[0] * normal[0] + direction[1] * normal[1]
@@ -100,7 +90,18 @@ def off_walls(
     if norm < 1e-6:
         return (0.0, 0.0)
     along = (tx / norm, ty / norm)
-    return (0.0, 0.0) if presses(along) else along
+    return (0.0, 0.0) if presses_wall(field, x, y, along, radius) else along
+
+
+def presses_wall(
+    field: DistanceField, x: float, y: float, direction: tuple[float, float], radius: float
+) -> bool:
+    """Whether a body of ``radius`` at (x, y) moving along the unit ``direction`` comes
+    nearer a wall than it may: than touching, or than it already is where it touches."""
+    floor = min(radius, float(field.distance_at(x, y)))
+    step = field.spacing
+    ahead = float(field.distance_at(x + direction[0] * step, y + direction[1] * step))
+    return ahead < floor - 1e-9
 
 
 def recovery_command(
@@ -140,7 +141,7 @@ def _backing(config: DwaConfig, field: DistanceField, pose: Pose, discs) -> tupl
     if norm < 1e-9:
         return (0.0, 0.0)
     left = (wx / norm, wy / norm)
-    if off_walls(field, pose[0], pose[1], left, config.radius) != left:
+    if presses_wall(field, pose[0], pose[1], left, config.radius):
         return (0.0, 0.0)
     return (vx, vy)
 
