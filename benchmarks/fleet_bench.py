@@ -65,35 +65,40 @@ def descendants(pid: int) -> list[int]:
     return children + [p for p, pp in parents.items() if pp in children]
 
 
-def thread_cpu_s(pid: int) -> tuple[float, float]:
-    """CPU seconds (user + system) of a process's main thread and of its other threads
-    ((0, 0) if it is gone)."""
-    main = other = 0.0
+def cpu_s(pid: int, tid: int | None = None) -> float:
+    """CPU seconds (user + system) of a process, its exited threads included, or of one of
+    its threads (0 if it is gone)."""
+    path = f"/proc/{pid}/stat" if tid is None else f"/proc/{pid}/task/{tid}/stat"
     try:
-        tids = os.listdir(f"/proc/{pid}/task")
+        with open(path) as f:
+            fields = f.read().rsplit(")", 1)[1].split()  # the name may hold spaces
     except OSError:
-        return 0.0, 0.0
-    for tid in tids:
-        try:
-            with open(f"/proc/{pid}/task/{tid}/stat") as f:
-                fields = f.read().rsplit(")", 1)[1].split()  # the name may hold spaces
-        except OSError:
-            continue
-        seconds = (int(fields[11]) + int(fields[12])) / TICKS_PER_S
-        if tid == str(pid):
-            main += seconds
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / TICKS_PER_S
+
+
+CpuSnapshot = dict[int, tuple[float, float]]
+
+
+def cpu_snapshot(world_pid: int) -> CpuSnapshot:
+    """Per process (the world and its descendants): CPU seconds so far of the main thread and
+    of the whole process. The whole counts threads that have exited, so that Zenoh's
+    short-lived threads are not lost between two snapshots."""
+    return {pid: (cpu_s(pid, pid), cpu_s(pid)) for pid in [world_pid, *descendants(world_pid)]}
+
+
+def cpu_split(before: CpuSnapshot, after: CpuSnapshot, world_pid: int) -> tuple[float, ...]:
+    """CPU seconds between two snapshots: the AGV processes' main threads, their other
+    threads, the world. Only processes alive at both count."""
+    agv_main = agv_other = world = 0.0
+    for pid in before.keys() & after.keys():
+        main = after[pid][0] - before[pid][0]
+        whole = after[pid][1] - before[pid][1]
+        if pid == world_pid:
+            world = whole
         else:
-            other += seconds
-    return main, other
-
-
-def cpu_split(world_pid: int) -> tuple[float, float, float]:
-    """CPU seconds so far: the AGV processes' main threads, their other threads, the world."""
-    agv_main = agv_other = 0.0
-    for pid in descendants(world_pid):
-        main, other = thread_cpu_s(pid)
-        agv_main, agv_other = agv_main + main, agv_other + other
-    return agv_main, agv_other, sum(thread_cpu_s(world_pid))
+            agv_main, agv_other = agv_main + main, agv_other + whole - main
+    return agv_main, agv_other, world
 
 
 def warehouse_grid() -> str:
@@ -137,7 +142,7 @@ class Clock:
         self.first = self.last = None
         self.ticks = 0
         self.world_pss = self.agvs_pss = 0
-        self.cpu: dict[int, tuple[float, float, float]] = {}
+        self.cpu: dict[int, CpuSnapshot] = {}
 
     def __call__(self, world) -> None:
         now = time.monotonic()
@@ -149,7 +154,7 @@ class Clock:
             self.world_pss = pss_kib(os.getpid())
             self.agvs_pss = sum(pss_kib(p) for p in descendants(os.getpid()))
         if world.tick in (CPU_FROM, CPU_TO):
-            self.cpu[world.tick] = cpu_split(os.getpid())
+            self.cpu[world.tick] = cpu_snapshot(os.getpid())
 
     @property
     def cpu_ms_per_tick(self) -> tuple[float, ...] | None:
@@ -158,7 +163,8 @@ class Clock:
         if CPU_TO not in self.cpu:
             return None
         span = CPU_TO - CPU_FROM
-        return tuple((b - a) * 1e3 / span for a, b in zip(self.cpu[CPU_FROM], self.cpu[CPU_TO]))
+        split = cpu_split(self.cpu[CPU_FROM], self.cpu[CPU_TO], os.getpid())
+        return tuple(seconds * 1e3 / span for seconds in split)
 
     @property
     def ticks_per_s(self) -> float:
