@@ -145,3 +145,15 @@ def test_plan_plot_draws_the_map_and_both_routes(public_data, tmp_path):
     red = (pixels[..., 0] > 0.8) & (pixels[..., 1] < 0.3) & (pixels[..., 2] < 0.3)
     blue = (pixels[..., 2] > 0.6) & (pixels[..., 0] < 0.3)
     assert red.sum() > 100 and blue.sum() > 100  # traditional dashed red, improved blue
+
+
+def test_the_cli_imports_the_rerun_sdk_only_to_show_a_run():
+    """Every AGV host and recorder process is this CLI: the Rerun SDK (0.6 s of import)
+    stays out of its start-up until ``replay`` or ``run --rerun`` needs it."""
+    check = (
+        "import sys; from fleet.cli.main import build_parser; build_parser(); "
+        "print(sorted(m for m in sys.modules if m.split('.')[0] == 'rerun'))"
+    )
+    out = subprocess.run([sys.executable, "-c", check], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"

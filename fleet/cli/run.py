@@ -21,7 +21,7 @@ from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
 from planner.profiles import PROFILES
-from recordings.rerun_view import LiveView, RerunError
+from recordings.rerun_server import RerunError
 from recordings.writer import default_recording_path
 
 DEFAULT_SCENARIO = "warehouse"
@@ -134,6 +134,10 @@ def run(args: argparse.Namespace) -> int:
             stack.enter_context(interrupts_raised())
             view = None
             if args.rerun:
+                # the Rerun SDK is imported only when asked for: it is 0.6 s of every
+                # start-up, and each AGV host and recorder process is this CLI
+                from recordings.rerun_view import LiveView
+
                 view = stack.enter_context(
                     LiveView(scenario.dt, save=args.rerun_save, web=args.rerun_web)
                 )
