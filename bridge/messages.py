@@ -14,7 +14,7 @@ import types
 import typing
 from dataclasses import dataclass, field
 
-from planner.agv_status import STATUSES
+from planner.agv_status import RECOVERY_KINDS, STATUSES
 from planner.errors import BadInputError
 from planner.traffic import PHASES, Intent
 
@@ -86,6 +86,7 @@ class AgvCommand:
     start_heading: float | None = None
     failure: str = ""  # why, when status is "failed"
     intent: Intent | None = None  # its traffic claim and route ahead (planner/traffic.py)
+    recovery: str = ""  # the recovery it started this period (planner/recovery.py), '' none
 
 
 @dataclass
@@ -168,6 +169,7 @@ class ResultMsg:
 CHOICES = {
     (AgvState, "status"): STATUSES,
     (AgvCommand, "status"): STATUSES,
+    (AgvCommand, "recovery"): ("", *RECOVERY_KINDS),
     (Intent, "phase"): PHASES,
 }
 

@@ -9,3 +9,8 @@ ARRIVED = "arrived"
 FAILED = "failed"
 STATUSES = (DRIVING, BLOCKED, WAITING, ARRIVED, FAILED)
 FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run
+
+# the recovery behaviours a stalled AGV runs (planner/recovery.py), reported as it starts
+# one, and the kind of the world's event for that
+REPLAN, WAIT, BACK_OFF, ROTATE = RECOVERY_KINDS = ("replan", "wait", "back off", "rotate")
+RECOVERY = "recovery"

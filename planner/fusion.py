@@ -42,7 +42,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from planner.agv_status import WAITING
+from planner.agv_status import REPLAN, WAITING
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.distance_field import DistanceField
@@ -148,6 +148,7 @@ class ControlStep:
     trajectory: np.ndarray
     plan: PlanResult | None
     plan_time_s: float
+    recovery: str = ""  # the recovery behaviour this cycle started ('' none)
 
 
 def _step(command, status, target=None, trajectory=None, plan=None) -> ControlStep:
@@ -185,6 +186,7 @@ class FusionController:
         self._rounding = False  # turning round on the spot to a waiting place (``FACED``)
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
+        self._recovery_started = ""  # in this cycle, for its ControlStep
         self._recoveries_done = 0
         self._jam_restarts = 0  # recovery sequences started again in a jam
         self._jammed = False  # another AGV was near at a stall of this sequence
@@ -294,9 +296,10 @@ class FusionController:
         the AGV (the default profile gets out of their way early); ``hold``: wait there
         (the traffic rule keeps the AGV out of a passage)."""
         t0 = time.perf_counter()
+        self._recovery_started = ""
         out = self._step(pose, command, now, moving, walkers, hold)
         self._previous = command
-        return replace(out, plan_time_s=time.perf_counter() - t0)
+        return replace(out, plan_time_s=time.perf_counter() - t0, recovery=self._recovery_started)
 
     def _step(self, pose, command, now, moving, walkers, hold=None) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
@@ -580,7 +583,8 @@ class FusionController:
             return None
         kind = RECOVERIES[self._recoveries_done]
         self._recoveries_done += 1
-        plan = self._plan_from(position, moving) if kind == "replan" else None
+        self._recovery_started = kind
+        plan = self._plan_from(position, moving) if kind == REPLAN else None
         if self.targets:
             self._best_remaining = self.remaining(position)
             self._stalled_before = self.targets[self.target_index]

@@ -15,11 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from planner.agv_status import BACK_OFF, REPLAN, ROTATE, WAIT
 from planner.distance_field import DistanceField
 from planner.dwa import Command, DwaConfig, Pose
 
-RECOVERIES = ("replan", "wait", "back off", "replan", "rotate", "replan")
-DURATION_S = {"replan": 0.0, "wait": 3.0, "back off": 2.0, "rotate": 3.0}
+RECOVERIES = (REPLAN, WAIT, BACK_OFF, REPLAN, ROTATE, REPLAN)
+DURATION_S = {REPLAN: 0.0, WAIT: 3.0, BACK_OFF: 2.0, ROTATE: 3.0}
 BACK_OFF_SPEED = 0.3  # m/s
 
 
@@ -112,9 +113,9 @@ def recovery_command(
     from the nearest obstacle, a wall or one of the ``discs`` (other AGVs, walkers; body
     frame, so an omnidirectional AGV needs no turn), ``rotate`` turns in place at the
     highest rate."""
-    if kind == "back off":
+    if kind == BACK_OFF:
         wanted = (*_backing(config, field, pose, discs), 0.0)
-    elif kind == "rotate":
+    elif kind == ROTATE:
         wanted = (0.0, 0.0, config.max_omega)
     else:
         wanted = (0.0, 0.0, 0.0)

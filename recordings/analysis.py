@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from planner import path_metrics
-from planner.agv_status import FINISHED, WAITING
+from planner.agv_status import FINISHED, RECOVERY, WAITING
 from planner.distance_field import DistanceField
 from planner.fusion import GLOBAL_ALGORITHM
 from planner.motion import world_velocity
@@ -70,6 +70,7 @@ class AgvAnalysis:
     waiting_time: float = 0.0  # s held outside passages
     waits: int = 0  # times it was held
     self_crossings: int = 0  # its loops: times its driven path crossed itself
+    recoveries: int = 0  # recovery behaviours it started (planner/recovery.py)
 
 
 @dataclass(frozen=True)
@@ -103,6 +104,7 @@ class RunAnalysis:
     waiting_time: float = 0.0  # s, summed over AGVs
     traffic_events: int = 0  # wait, go and yield events
     self_crossings: int = 0  # summed over AGVs
+    recoveries: int = 0  # summed over AGVs
 
     @property
     def label(self) -> str:
@@ -141,11 +143,14 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
     hits = Counter(n for e in collisions for n in e.get("agvs", []))
     traffic = [e for e in series.events if e.get("kind") in DECISIONS]
     waits = Counter(e["agvs"][0] for e in traffic if e.get("kind") == WAIT and e.get("agvs"))
+    recoveries = Counter(
+        e["agvs"][0] for e in series.events if e.get("kind") == RECOVERY and e.get("agvs")
+    )
     agvs, cycles = [], []
     for i, name in enumerate(series.agvs.names):
         clearance = (_finite(obstacle_gap[i]), _finite(agv_gap[i]))
         agv, plan_times = _agv(series, i, dt, statuses.get(name), hits[name], clearance)
-        agvs.append(replace(agv, waits=waits[name]))
+        agvs.append(replace(agv, waits=waits[name], recoveries=recoveries[name]))
         cycles.append(plan_times)
     plan_times = np.concatenate(cycles) if cycles else np.zeros(0)
     run = rec.run
@@ -179,6 +184,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         waiting_time=sum(a.waiting_time for a in agvs),
         traffic_events=len(traffic),
         self_crossings=sum(a.self_crossings for a in agvs),
+        recoveries=sum(a.recoveries for a in agvs),
     )
 
 
@@ -346,6 +352,7 @@ COMPARED = (
     ("self_crossings", "loops (path self-crossings)", ""),
     ("waiting_time", "waiting time", "s"),
     ("traffic_events", "traffic events", ""),
+    ("recoveries", "recoveries", ""),
     ("plan_time_mean_ms", "plan time mean", "ms"),
     ("plan_time_p95_ms", "plan time p95", "ms"),
 )

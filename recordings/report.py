@@ -31,11 +31,12 @@ AGV_COLUMNS = (
     ("collisions", "", "collisions", "{}", True),
     ("waiting", "s", "waiting_time", "{:.1f}", False),
     ("waits", "", "waits", "{}", False),
+    ("recoveries", "", "recoveries", "{}", False),
     ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
     ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
 )
 HIDDEN_NOTE = (
-    "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, planning and waiting times)"
+    "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, planning, waiting, recoveries)"
 )
 
 
@@ -63,7 +64,8 @@ def run_table(run: RunAnalysis, wide: bool = False) -> str:
     )
     table = text_table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
     note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
-    return f"{table}\n{line}{_loops_line(run)}{_traffic_line(run)}{note}"
+    lines = f"{_loops_line(run)}{_traffic_line(run)}{_recoveries_line(run)}"
+    return f"{table}\n{line}{lines}{note}"
 
 
 def _loops_line(run: RunAnalysis) -> str:
@@ -83,6 +85,14 @@ def _traffic_line(run: RunAnalysis) -> str:
     return f"\ntraffic: {run.traffic_events} decisions, {run.waiting_time:.1f} s waiting in all" + (
         f" ({each})" if each else ""
     )
+
+
+def _recoveries_line(run: RunAnalysis) -> str:
+    """The AGVs that stalled and ran recovery behaviours, when any did."""
+    if not run.recoveries:
+        return ""
+    each = _most(run, lambda a: a.recoveries, "{}")
+    return f"\nrecoveries: {run.recoveries} started after no progress ({each})"
 
 
 def _most(run: RunAnalysis, value, fmt: str, shown: int = 4) -> str:

@@ -45,7 +45,7 @@ import rerun as rr
 
 from bridge import keys
 from bridge.messages import MessageError
-from planner.agv_status import FINISHED
+from planner.agv_status import FINISHED, RECOVERY
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.passages import NONE, Passages
@@ -68,7 +68,7 @@ QUANTITIES = ("vx", "vy", "speed", "omega")
 
 WHITE, GREY, ORANGE, DARK = (230, 230, 230), (160, 160, 160), (255, 160, 0), (20, 20, 20)
 FREE_SHADE, BLOCKED_SHADE = 225, 70  # grey levels of the map image
-LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN"}
+LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN", RECOVERY: "WARN"}
 WAITING_RING = 1.6  # x radius: the ring shows round the body
 HEADING_LENGTH = 2.0  # x radius: the heading line sticks out of the disc, visible when small
 LABEL_GAP = 1.0  # m right of the disc's rim: the name (centred on its anchor) never covers it

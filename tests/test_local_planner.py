@@ -5,6 +5,7 @@ a stall that must end in ``failed`` with its reason."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -14,7 +15,7 @@ import pytest
 
 from bridge import keys
 from fleet.moving_obstacle import MovingObstacle
-from fleet.runtime.inprocess import run_in_process
+from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.scenario import (
     AgvSpec,
     Scenario,
@@ -24,6 +25,7 @@ from fleet.scenario import (
     parse_scenario,
     with_profile,
 )
+from planner.agv_status import RECOVERY
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner, step_pose
 from planner.evasion import contact_times, evasive_index, into_wall
@@ -32,8 +34,11 @@ from planner.grid_map import GridMap
 from planner.local_behaviour import local_behaviour
 from planner.map_io import load_map, parse_text_grid
 from planner.parked_discs import blocking_cells, covered_cells
-from planner.recovery import away_from_obstacles, recovery_command
+from planner.recovery import RECOVERIES, away_from_obstacles, recovery_command
 from planner.route_check import blocked_point
+from recordings.analysis import analyze
+from recordings.reader import open_recording
+from recordings.report import run_table
 
 DATA = Path(__file__).parent / "data"
 REALISTIC = DwaConfig(
@@ -300,14 +305,36 @@ def test_the_body_faces_its_direction_of_travel_unless_free_heading_is_asked():
     assert _sideways_share(paper) > 0.5
 
 
+BLOCKED_GAP = parse_text_grid("\n".join(["." * 14, "#" * 6 + "." + "#" * 7, "." * 14]))
+PARKED = MovingObstacle("parked", 0.45, ((6.5, 1.5),), 0.0)  # stands in the only gap
+
+
 def test_a_blocked_corridor_ends_in_failed_with_the_reason_not_endless_driving():
-    grid = parse_text_grid("\n".join(["." * 14, "#" * 6 + "." + "#" * 7, "." * 14]))
-    parked = MovingObstacle("parked", 0.45, ((6.5, 1.5),), 0.0)  # stands in the only gap
-    summary, _ = run(scenario(grid, (1.5, 0.5), (12.5, 2.5), moving=[parked]))
+    summary, _ = run(scenario(BLOCKED_GAP, (1.5, 0.5), (12.5, 2.5), moving=[PARKED]))
     agv = summary.agvs[0]
     assert agv.status == "failed" and agv.collisions == 0
     assert "no progress after the recoveries" in agv.failure
     assert summary.sim_time < 100
+
+
+def test_each_recovery_is_an_event_in_the_recording_that_analyze_counts(tmp_path):
+    path = tmp_path / "stall.mcap"
+    sc = scenario(BLOCKED_GAP, (1.5, 0.5), (12.5, 2.5), moving=[PARKED])
+    run_recorded(sc, path, {"mode": "in-process"})
+    rec = open_recording(path)
+    events = list(rec.data_of(keys.WORLD_EVENT))
+    started = [e for e in events if e["kind"] == RECOVERY]
+    # the whole sequence, in order, each after a progress window without progress
+    assert [e["detail"].rsplit(": ", 1)[1] for e in started] == list(RECOVERIES)
+    assert all(e["agvs"] == ["agv"] and "no progress for 5 s" in e["detail"] for e in started)
+    assert all(b["time"] - a["time"] >= 5.0 for a, b in itertools.pairwise(started))
+    failed = next(e for e in events if e["kind"] == "failed")
+    assert failed["time"] > started[-1]["time"]
+    commands = [c for c in rec.data_of("agv/agv/command") if c["recovery"]]
+    assert [c["recovery"] for c in commands] == list(RECOVERIES)  # as the AGV reported them
+    run_ = analyze(rec)
+    assert run_.recoveries == run_.agvs[0].recoveries == len(RECOVERIES)
+    assert f"recoveries: {len(RECOVERIES)} started after no progress (agv 6)" in run_table(run_)
 
 
 def test_the_planner_profile_is_a_scenario_key():

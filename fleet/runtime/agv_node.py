@@ -112,6 +112,7 @@ class AgvNode:
         command.start_heading = start_heading
         command.failure = self.controller.failure if step.status == FAILED else ""
         command.intent = decision.intent if decision else None
+        command.recovery = step.recovery
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(

@@ -18,7 +18,7 @@ import numpy as np
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
-from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED, WAITING
+from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED, RECOVERY, WAITING
 from planner.distance_field import DistanceField
 from planner.dwa import step_pose
 from planner.grid_map import GridMap
@@ -146,6 +146,10 @@ class World:
         if status == WAITING:
             record.waiting_time += self.dt
         self._take_intent(name, command.intent, status)
+        if command.recovery and status not in FINISHED:
+            window = spec.config.progress_window
+            why = f"no progress for {window:g} s: {command.recovery}"
+            self.events.append(Event(self.tick, self.time, RECOVERY, [name], why))
         self.states[name] = AgvState(
             name, self.tick, x, y, theta, *velocity, old.radius, status,
             command.target, command.plan_time_ms, command.failure if status == FAILED else "",
