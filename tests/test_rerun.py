@@ -266,6 +266,21 @@ def test_replay_save_writes_an_rrd_with_one_velocity_row_per_state(corridor, tmp
         assert len(entities[f"/velocity/vx/{name}"].rows) == len(states)
 
 
+def test_run_rerun_save_writes_the_live_view_and_without_a_display_names_runs_flags(
+    corridor, replayed, tmp_path
+):
+    """The CLI imports the Rerun SDK only inside ``run --rerun``: that path, end to end."""
+    out = tmp_path / "live.rrd"
+    done = agv_fleet("run", "corridor", "--in-process", "--no-record", "-q", "--rerun",
+                     "--rerun-save", str(out))  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert set(read_rrd(out)) == set(replayed)  # the live view shows what the replay shows
+    done = agv_fleet("run", "corridor", "--in-process", "--no-record", "-q", "--rerun")
+    assert done.returncode == 3
+    line = one_line(done.stderr)
+    assert "no display" in line and "--rerun-save" in line and "--rerun-web" in line
+
+
 def test_replay_without_a_display_or_save_or_web_exits_3_with_one_line(corridor):
     done = agv_fleet("replay", str(corridor["mcap"]))
     assert done.returncode == 3  # an environment failure: nowhere to show it
