@@ -320,7 +320,8 @@ def test_a_blocked_corridor_ends_in_failed_with_the_reason_not_endless_driving()
 def test_each_recovery_is_an_event_in_the_recording_that_analyze_counts(tmp_path):
     path = tmp_path / "stall.mcap"
     sc = scenario(BLOCKED_GAP, (1.5, 0.5), (12.5, 2.5), moving=[PARKED])
-    run_recorded(sc, path, {"mode": "in-process"})
+    summary = run_recorded(sc, path, {"mode": "in-process"})
+    assert summary.to_json()["agvs"][0]["recoveries"] == len(RECOVERIES)  # run's summary
     rec = open_recording(path)
     events = list(rec.data_of(keys.WORLD_EVENT))
     started = [e for e in events if e["kind"] == RECOVERY]

@@ -28,6 +28,7 @@ class AgvSummary:
     refused: int = 0  # reports the world did not believe
     waiting_time: float = 0.0  # s waiting outside passages other AGVs had
     self_crossings: int = 0  # times its driven path crossed itself: its loops
+    recoveries: int = 0  # recovery behaviours started after no progress
 
 
 @dataclass(frozen=True)
@@ -66,6 +67,7 @@ class RunSummary:
                     else None,
                     "waiting_time": round(a.waiting_time, 3),
                     "self_crossings": a.self_crossings,
+                    "recoveries": a.recoveries,
                     **({"failure": a.failure} if a.failure else {}),
                     **({"clipped_commands": a.clipped} if a.clipped else {}),
                     **({"refused_reports": a.refused} if a.refused else {}),
@@ -84,10 +86,11 @@ class RunSummary:
                 "distance",
                 "route",
                 "loops",
+                "recoveries",
                 "collisions",
                 "min clearance",
             ],
-            ["", "", "s", "m", "m", "", "", "m"],
+            ["", "", "s", "m", "m", "", "", "", "m"],
         ]
         rows = [
             [
@@ -97,6 +100,7 @@ class RunSummary:
                 f"{a.distance:.2f}",
                 "-" if a.route_length is None else f"{a.route_length:.2f}",
                 str(a.self_crossings),
+                str(a.recoveries),
                 str(a.collisions),
                 f"{a.min_clearance:.2f}" if math.isfinite(a.min_clearance) else "-",
             ]
@@ -132,6 +136,7 @@ def summarize(world: World, wall_time: float) -> RunSummary:
                 r.refused,
                 r.waiting_time,
                 self_crossings(r.track),
+                r.recoveries,
             )
         )
     return RunSummary(

@@ -44,6 +44,7 @@ class AgvRecord:
     clipped: int = 0  # commands beyond the AGV's limits, clipped by the world
     refused: int = 0  # reports the world did not believe (an arrival away from the goal)
     waiting_time: float = 0.0  # s spent waiting outside a passage (planner/traffic.py)
+    recoveries: int = 0  # recovery behaviours started after no progress (planner/recovery.py)
     track: array = field(default_factory=lambda: array("d"))  # x, y, x, y, ... tick by tick
 
 
@@ -147,6 +148,7 @@ class World:
             record.waiting_time += self.dt
         self._take_intent(name, command.intent, status)
         if command.recovery and status not in FINISHED:
+            record.recoveries += 1
             window = spec.config.progress_window
             why = f"no progress for {window:g} s: {command.recovery}"
             self.events.append(Event(self.tick, self.time, RECOVERY, [name], why))
