@@ -65,7 +65,8 @@ def outcome(summary: RunSummary) -> dict:
         "sim_time": round(summary.sim_time, 6),
         "collisions": summary.collisions,
         "agvs": {
-            a.name: [a.status, a.arrival_time, a.collisions, a.self_crossings] for a in summary.agvs
+            a.name: [a.status, a.arrival_time, a.collisions, a.self_crossings, a.recoveries]
+            for a in summary.agvs
         },
     }
 
@@ -111,6 +112,7 @@ def run_case(family: str, seed: int) -> dict:
         },
         "statuses": {a.name: a.status for a in summary.agvs},
         "self_crossings": {a.name: a.self_crossings for a in summary.agvs if a.self_crossings},
+        "recoveries": {a.name: a.recoveries for a in summary.agvs if a.recoveries},
         "failures": {a.name: a.failure for a in summary.agvs if a.failure},
         "outcome": outcome(summary),
         "wall_s": round(wall, 2),
@@ -164,6 +166,7 @@ def family_rows(results: list[dict]) -> list[dict]:
                 "worst_driven_over_route": max(detours) if detours else None,
                 "agvs_over_detour": sum(d > DETOUR for d in detours),
                 "loops": sum(n for r in runs for n in r["self_crossings"].values()),
+                "recoveries": sum(n for r in runs for n in r["recoveries"].values()),
                 "solo_failures": sum(len(r["solo_failures"]) for r in runs),
                 "time_limit_s": [limits[0], limits[-1]],
             }
@@ -181,7 +184,7 @@ def print_table(rows: list[dict]) -> None:
         f"{'coll':>4} "
         f"{'limit':>5} {'mk/sum med':>10} {'mk/sum max':>10} {'mk/long med':>11} "
         f"{'wait mean':>9} {'wait max':>8} {'drive max':>9} {f'>{DETOUR:g}x':>5} {'loops':>5} "
-        f"{'solo fail':>9} {'time limit s':>12}"
+        f"{'recov':>5} {'solo fail':>9} {'time limit s':>12}"
     )
     print(header)
     print("-" * len(header))
@@ -195,7 +198,7 @@ def print_table(rows: list[dict]) -> None:
             f"{_f(r['median_makespan_over_longest_solo'], '.2f'):>11} "
             f"{_f(r['mean_wait_s'], '.1f'):>9} {_f(r['max_wait_s'], '.1f'):>8} "
             f"{_f(r['worst_driven_over_route'], '.2f'):>9} {r['agvs_over_detour']:>5} "
-            f"{r['loops']:>5} "
+            f"{r['loops']:>5} {r['recoveries']:>5} "
             f"{r['solo_failures']:>9} {f'{lo:g}-{hi:g}':>12}"
         )
     print(
@@ -206,7 +209,8 @@ def print_table(rows: list[dict]) -> None:
         "passage by the traffic rule (status 'waiting'); drive max: the most an AGV drove over\n"
         f"the length of its first route (loops and detours show here); >{DETOUR:g}x: AGVs that\n"
         "drove more than that; loops: times the AGVs' driven paths crossed themselves\n"
-        "(planner.path_metrics.self_crossings); solo fail: AGVs that do not arrive alone."
+        "(planner.path_metrics.self_crossings); recov: recovery behaviours the AGVs started after\n"
+        "no progress (planner.recovery); solo fail: AGVs that do not arrive alone."
     )
 
 
