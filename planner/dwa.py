@@ -57,6 +57,7 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Sequence
 from dataclasses import dataclass, fields
 
 import numba
@@ -560,7 +561,7 @@ class DwaPlanner:
         approach: bool = False,
         segment: tuple[tuple[float, float], tuple[float, float]] | None = None,
         route: list[tuple[float, float]] | None = None,
-        came_by: list[tuple[float, float]] = (),
+        came_by: Sequence[tuple[float, float]] = (),
         walkers: np.ndarray | None = None,
         lane_room: float | None = None,
     ) -> DwaResult:

@@ -18,8 +18,9 @@ TRAIL_STEP = 0.25
 """m between the positions kept."""
 
 TRAIL_LENGTH = 20.0
-"""m of tracks kept: more than a walker at 1.5 m/s covers within the longest yield
-horizon (about 13 s at Table 1's limits from 0.5 m/s)."""
+"""m of tracks kept. A walker's way matters where the AGV could stand at the end of a
+sample, within a few metres of it; the tracks further back only where they curl back
+near the AGV. Beyond them the walker is taken to stand where they end."""
 
 
 class Trail:
