@@ -29,7 +29,7 @@ from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
-from fleet.runtime.world_server import WorldServer
+from fleet.runtime.world_server import START_TIMEOUT_S, WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S, WorldGone
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.fusion import VARIANTS
@@ -87,9 +87,9 @@ def add_parsers(sub) -> None:
     w.add_argument(
         "--start-timeout",
         type=positive_float,
-        default=60.0,
+        default=START_TIMEOUT_S,
         metavar="S",
-        help="how long to wait for every AGV before tick 0 (default 60)",
+        help=f"how long to wait for every AGV before tick 0 (default {START_TIMEOUT_S:g})",
     )
     w.add_argument("--json", action="store_true")
     w.add_argument("--quiet", "-q", action="store_true")

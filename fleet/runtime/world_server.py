@@ -31,6 +31,10 @@ from planner.errors import EnvironmentFailure
 
 POLL_S = 0.02
 RESEND_S = 0.5  # while an AGV is lost, tick k goes out again this often
+START_TIMEOUT_S = 60.0
+"""How long the world waits for every AGV before tick 0. A first run on a fresh install
+compiles every numba kernel in the AGV host before its AGVs come up (about 37 s on a
+2-core machine); 30 s failed it as soon as the host had more to warm up."""
 
 
 class FleetStartError(EnvironmentFailure):
@@ -45,7 +49,7 @@ class WorldServer:
         *,
         tick_timeout: float = 2.0,
         grace: float = DEFAULT_GRACE_S,
-        start_timeout: float = 30.0,
+        start_timeout: float = START_TIMEOUT_S,
         realtime: float | None = None,
         progress: Callable[[World], None] | None = None,
         abort_check: Callable[[], str | None] | None = None,
