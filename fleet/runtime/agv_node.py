@@ -57,9 +57,15 @@ class AgvNode:
         self._started = False
 
     def warm_up(self) -> None:
-        """Load (or compile) every numba kernel this node uses, before the run starts."""
+        """Load (or compile) every numba kernel this node uses, before the run starts.
+
+        It plans this AGV's route once, on the run's map: the costmap's centring and
+        clearance kernels are loaded only by a real route, and an AGV host that forks
+        its AGV processes after this spares each of them loading them again (with 50
+        AGVs on 2 cores, 0.8 s of the start-up). The node is spent: a throwaway."""
         warm_up()
         start, goal, dwa = self.spec.start, self.spec.goal, self.controller.dwa
+        self.controller.start((*start, 0.0))
         dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, segment=(start, goal))
         walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
         dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, walker)
