@@ -244,3 +244,26 @@ def test_an_agv_with_no_world_gives_up_with_one_line(tmp_path):
     )  # fmt: skip
     assert proc.returncode == 3  # an environment failure: nothing to connect to
     assert proc.stderr.count("\n") == 1 and "no router" in proc.stderr
+
+
+@pytest.mark.parametrize("quiet", [False, True], ids=["progress", "quiet"])
+def test_a_world_waiting_for_its_agvs_says_so_once_unless_quiet(tmp_path, quiet):
+    """A first run after an install is quiet for about 40 s while the AGV host compiles
+    the planner: the world says what it waits for (not with -q), then fails the AGVs that
+    never came."""
+    endpoint = fresh_endpoint("unix", tmp_path)
+    cmd = [*CLI, "world", "corridor", "--listen", endpoint, "--start-timeout", "4"]
+    done = subprocess.run(
+        cmd + (["-q"] if quiet else []), capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 1, done.stderr  # no AGV came: both failed
+    said = [line for line in done.stderr.splitlines() if line.startswith("waiting for")]
+    assert said == (
+        []
+        if quiet
+        else [
+            "waiting for 2 of 2 AGVs to come up (up to 4 s; the "
+            "first run after an install compiles the planner first)"
+        ]
+    )
+    assert "did not come up within 4 s" in done.stdout

@@ -170,6 +170,7 @@ def run_world(args: argparse.Namespace) -> int:
             tick_timeout=args.tick_timeout,
             grace=args.grace,
             start_timeout=args.start_timeout,
+            say_waiting=not args.quiet,
             realtime=args.realtime,
             progress=None if args.quiet else Progress(scenario),
         )

@@ -204,6 +204,7 @@ def _run(args, scenario, record_path, progress, view):
         tick_timeout=args.tick_timeout,
         grace=args.grace,
         record_path=record_path,
+        say_waiting=not args.quiet,
     )
     return run_fleet(scenario, options, progress=progress, tap=view)
 

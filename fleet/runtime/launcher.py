@@ -52,6 +52,7 @@ class FleetOptions:
     tick_timeout: float = 2.0
     grace: float = DEFAULT_GRACE_S
     record_path: Path | None = None  # None: no recorder
+    say_waiting: bool = False  # tell on stderr when the AGVs are slow to come up
 
 
 def agv_command(options: FleetOptions, names: list[str], endpoint: str, prefix: str) -> list[str]:
@@ -123,6 +124,7 @@ def run_fleet(
                     progress=progress,
                     abort_check=lambda: _exited_early(children),
                     recorder=options.record_path is not None,
+                    say_waiting=options.say_waiting,
                 )
                 summary = server.run()
                 if progress:

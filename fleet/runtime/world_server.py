@@ -20,6 +20,7 @@ from collections.abc import Callable
 
 from bridge import keys
 from bridge.bus import Bus
+from bridge.log import say
 from bridge.messages import AgvCommand, Tick
 from fleet.runtime.interrupts import interrupted, raise_if_interrupted
 from fleet.runtime.lockstep import run_lockstep
@@ -35,6 +36,7 @@ START_TIMEOUT_S = 60.0
 """How long the world waits for every AGV before tick 0. A first run on a fresh install
 compiles every numba kernel in the AGV host before its AGVs come up (about 37 s on a
 2-core machine); 30 s failed it as soon as the host had more to warm up."""
+SAY_WAITING_AFTER_S = 3.0  # a wait this long for the AGVs is said (``say_waiting``)
 
 
 class FleetStartError(EnvironmentFailure):
@@ -54,12 +56,14 @@ class WorldServer:
         progress: Callable[[World], None] | None = None,
         abort_check: Callable[[], str | None] | None = None,
         recorder: bool = False,
+        say_waiting: bool = False,
     ):
         self.scenario = scenario
         self.bus = bus
         self.tick_timeout = tick_timeout
         self.grace = grace
         self.start_timeout = start_timeout
+        self.say_waiting = say_waiting  # on stderr, a wait for the AGVs that is not short
         self.realtime = realtime
         self.progress = progress
         self.abort_check = abort_check
@@ -110,10 +114,19 @@ class WorldServer:
         """Every AGV's token before tick 0 (it is declared after its tick subscriber),
         and the recorder's, if one is expected, so that it misses nothing."""
         names = {a.name for a in self.scenario.agvs}
-        deadline = time.monotonic() + self.start_timeout
+        start = time.monotonic()
+        deadline = start + self.start_timeout
+        said = not self.say_waiting
         recorder_up = self._recorder is None
         while not (recorder_up and names <= self.alive) and time.monotonic() < deadline:
             self._update_liveliness(timeout=POLL_S)
+            if not said and time.monotonic() > start + SAY_WAITING_AFTER_S:
+                said = True
+                say(
+                    f"waiting for {len(names - self.alive)} of {len(names)} AGVs to come up "
+                    f"(up to {self.start_timeout:g} s; the first run after an install compiles "
+                    "the planner first)"
+                )
             if not recorder_up:
                 with contextlib.suppress(queue.Empty):
                     recorder_up = self._recorder.get_nowait()[1]
