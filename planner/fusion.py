@@ -42,7 +42,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from planner.agv_status import REPLAN, WAITING
+from planner.agv_status import BACK_OFF, REPLAN, ROTATE, WAIT, WAITING
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.distance_field import DistanceField
@@ -582,6 +582,8 @@ class FusionController:
             )
             return None
         kind = RECOVERIES[self._recoveries_done]
+        if kind in (BACK_OFF, ROTATE) and _agv_near(position, moving, walkers):
+            kind = WAIT  # the others plan too: moving into their room only pushes them
         self._recoveries_done += 1
         self._recovery_started = kind
         plan = self._plan_from(position, moving) if kind == REPLAN else None

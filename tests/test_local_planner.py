@@ -25,7 +25,7 @@ from fleet.scenario import (
     parse_scenario,
     with_profile,
 )
-from planner.agv_status import RECOVERY
+from planner.agv_status import BACK_OFF, RECOVERY, ROTATE, WAIT
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig, DwaPlanner, step_pose
 from planner.evasion import contact_times, evasive_index, into_wall
@@ -545,6 +545,31 @@ def test_a_stall_among_agvs_is_a_jam_and_the_recoveries_start_again_before_faili
     jam = _fails_at(disc, np.zeros((0, 5)))  # another AGV
     assert alone < math.inf and jam < math.inf  # bounded either way
     assert jam > 2.5 * alone  # the sequence ran three times
+
+
+def _recoveries_started(moving: np.ndarray, walkers: np.ndarray) -> list[str]:
+    """The recoveries a controller held in place (as ``_fails_at``) starts, in order, until
+    its first sequence has run out."""
+    grid = parse_text_grid("\n".join(["." * 12] * 12))
+    controller = FusionController(grid, (10.5, 6.0), FusionConfig())
+    pose = (2.0, 6.0, 0.0)
+    controller.start(pose)
+    started = []
+    for k in range(6000):
+        out = controller.step(pose, (0.0, 0.0, 0.0), 0.1 * k, moving, walkers)
+        started += [out.recovery] if out.recovery else []
+        if len(started) == len(RECOVERIES):
+            return started
+    return started
+
+
+def test_in_a_jam_the_recoveries_wait_instead_of_backing_off_and_rotating():
+    # warehouse-40 n40 s4: agv26's back-off carried it across the cross aisle, among AGVs
+    disc = np.array([[2.0, 7.0, 0.0, 0.0, 0.3]])  # 1 m beside the AGV
+    assert _recoveries_started(disc, disc) == list(RECOVERIES)  # a walker: Nav2's sequence
+    in_a_jam = _recoveries_started(disc, np.zeros((0, 5)))  # another AGV
+    assert in_a_jam == [WAIT if r in (BACK_OFF, ROTATE) else r for r in RECOVERIES]
+    assert BACK_OFF in RECOVERIES and ROTATE in RECOVERIES
 
 
 def test_the_last_metres_to_a_waiting_place_are_driven_straight_not_in_arcs():
