@@ -16,7 +16,9 @@ fusion's targets: 100 % success, 0 collisions, median driven/shortest <=
 ``--first-seed 200`` generates the episodes from seed 200 on: a held-out set, for
 episodes the planner was not tuned on. ``--seeds 8,40,42`` runs just those episodes and
 prints one line for each (status, arrival, collisions, driven/shortest), to iterate on
-them.
+them. ``--write-toml DIR`` writes the chosen episodes as scenario files and exits: ``agv-fleet
+run DIR/nav-282.toml --rerun`` shows one in Rerun (``--algorithm``, ``--profile`` for the
+other variants), and ``agv-fleet analyze`` plots its recording.
 """
 
 from __future__ import annotations
@@ -148,6 +150,19 @@ def selected(seeds: str) -> list[Episode]:
     return out
 
 
+def write_toml(eps: list[Episode], folder: Path) -> None:
+    """Each episode as ``folder/nav-SEED.toml`` (the default fusion; ``agv-fleet run``'s
+    ``--algorithm`` and ``--profile`` run it as another variant)."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        for e in eps:
+            (folder / f"nav-{e.seed}.toml").write_text(e.toml())
+    except OSError as err:
+        sys.stderr.write(f"nav_bench: cannot write {folder}: {err}\n")
+        sys.exit(2)
+    print(f"wrote {len(eps)} episodes to {folder}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--episodes", type=int, default=100)
@@ -158,9 +173,15 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--variants", default="all", help="'all' or a comma list of labels")
     parser.add_argument("--seeds", help="a comma list of episode seeds, in place of --episodes")
+    parser.add_argument("--write-toml", type=Path, metavar="DIR",
+                        help="write the episodes as scenario files nav-SEED.toml into DIR and "
+                        "exit (agv-fleet run reads them)")  # fmt: skip
     args = parser.parse_args()
     chosen = [v for v in VARIANTS if args.variants == "all" or v[0] in args.variants.split(",")]
     eps = selected(args.seeds) if args.seeds else episodes(args.episodes, args.first_seed)
+    if args.write_toml:
+        write_toml(eps, args.write_toml)
+        return
     jobs = [(e, *v) for e in eps for v in chosen]
     t0 = time.perf_counter()
     with multiprocessing.get_context("spawn").Pool(max(1, min(args.workers, 2))) as pool:

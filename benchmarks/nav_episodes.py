@@ -86,6 +86,58 @@ class Episode:
             path="",
         )
 
+    def toml(self, algorithm: str = "fusion", profile: str = "default") -> str:
+        """The episode as a scenario file that ``agv-fleet run`` reads as ``scenario``
+        reads it (a test checks they are equal): to watch an episode in Rerun or plot it
+        with ``analyze``. Angles are written in degrees, as the format has them."""
+        vehicle = {k: math.degrees(v) if "omega" in k or "alpha" in k else v
+                   for k, v in VEHICLES[self.vehicle].items()}  # fmt: skip
+        lines = [
+            f'name = "nav-{self.seed}"',
+            f'description = "nav_bench episode {self.seed}: {self.vehicle} vehicle, '
+            f'goal {self.goal_kind}, {self.events}"',
+            "dt = 0.1",
+            f"time_limit = {round(60 + 6 * self.shortest)}",
+            f"sensing_radius = {SENSING_RADIUS}",
+            f'profile = "{profile}"',
+            "",
+            "[map]",
+            f"resolution = {self.grid.resolution!r}",
+            f'grid = """\n{_grid_text(self.grid.blocked)}\n"""',
+            "",
+            "[planner]",
+            f'algorithm = "{algorithm}"',
+            "",
+            "[agv_defaults]",
+            f"radius = {RADIUS}",
+            *(f"{k} = {round(v, 9)!r}" for k, v in vehicle.items()),
+            "",
+            "[[agvs]]",
+            'name = "agv"',
+            f"start = [{self.start[0]!r}, {self.start[1]!r}]",
+            f"goal = [{self.goal[0]!r}, {self.goal[1]!r}]",
+            "heading = 0.0",
+        ]
+        for wall in self.temporary:
+            cells = ", ".join(f"[{c}, {r}]" for c, r in wall.cells)
+            lines += ["", "[[obstacles]]", 'type = "temporary"', f'name = "{wall.name}"',
+                      f"cells = [{cells}]", f"appear_at = {wall.appear_at!r}"]  # fmt: skip
+        for walker in self.moving:
+            points = ", ".join(f"[{x!r}, {y!r}]" for x, y in walker.waypoints)
+            lines += [
+                "", "[[obstacles]]", 'type = "moving"', f'name = "{walker.name}"',
+                f"radius = {walker.radius!r}", f"waypoints = [{points}]",
+                f"speed = {walker.speed!r}", f'mode = "{walker.mode}"',
+                f"start_at = {walker.start_at!r}",
+            ]  # fmt: skip
+        return "\n".join(lines) + "\n"
+
+
+def _grid_text(blocked: np.ndarray) -> str:
+    """Rows top to bottom as a scenario file prints them; ``blocked[row, col]`` has row 0
+    at the bottom."""
+    return "\n".join("".join("#" if b else "." for b in row) for row in blocked[::-1])
+
 
 def body_path(
     grid: GridMap, start, goal, radius: float = RADIUS, discs=()

@@ -1,5 +1,6 @@
 """The nav_bench episodes are fair: walkers keep off the walls and a crossing walker crosses
-the route once, leaving it free, instead of bouncing across it through walls."""
+the route once, leaving it free, instead of bouncing across it through walls. Written as a
+scenario file, an episode is the same scenario."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import math
 import numpy as np
 
 from benchmarks.nav_episodes import CROSSING_CLEAR, WALKER_RADIUS, episodes
+from fleet.scenario import parse_scenario
 from planner.distance_field import DistanceField
 
 EPISODES = episodes(30)
@@ -44,3 +46,19 @@ def test_a_crossing_walker_crosses_once_and_ends_clear_of_the_route():
         a, b = np.array(walker.waypoints)
         # both ends at least CROSSING_CLEAR from where the line meets the route, on either side
         assert math.dist(a, b) >= 2 * CROSSING_CLEAR - 1e-6, episode.seed
+
+
+def test_an_episode_written_as_a_scenario_file_reads_back_as_the_same_scenario():
+    for episode, (algorithm, profile) in zip(
+        EPISODES, itertools.cycle([("fusion", "default"), ("dwa", "paper")]), strict=False
+    ):
+        read = parse_scenario(episode.toml(algorithm, profile))
+        built = episode.scenario(algorithm, profile)
+        assert read.agvs == built.agvs, episode.seed  # vehicle limits and planner included
+        assert read.moving == built.moving and read.temporary == built.temporary
+        assert (read.grid.blocked == built.grid.blocked).all()
+        assert read.grid.resolution == built.grid.resolution
+        assert (read.dt, read.time_limit, read.sensing_radius) == (
+            built.dt, built.time_limit, built.sensing_radius,
+        )  # fmt: skip
+    assert any(e.moving for e in EPISODES) and any(e.temporary for e in EPISODES)
