@@ -103,7 +103,7 @@ class Episode:
             "",
             "[map]",
             f"resolution = {self.grid.resolution!r}",
-            f'grid = """\n{_grid_text(self.grid.blocked)}\n"""',
+            f'grid = """\n{self.grid.to_text()}\n"""',
             "",
             "[planner]",
             f'algorithm = "{algorithm}"',
@@ -131,12 +131,6 @@ class Episode:
                 f"start_at = {walker.start_at!r}",
             ]  # fmt: skip
         return "\n".join(lines) + "\n"
-
-
-def _grid_text(blocked: np.ndarray) -> str:
-    """Rows top to bottom as a scenario file prints them; ``blocked[row, col]`` has row 0
-    at the bottom."""
-    return "\n".join("".join("#" if b else "." for b in row) for row in blocked[::-1])
 
 
 def body_path(

@@ -112,11 +112,6 @@ class TrafficCase:
 
 
 # --- maps ------------------------------------------------------------------------------
-def _grid_text(blocked: np.ndarray) -> str:
-    """Rows top to bottom as printed; ``blocked[row, col]`` has row 0 at the bottom."""
-    return "\n".join("".join("#" if b else "." for b in row) for row in blocked[::-1])
-
-
 def _centre(col: float, row: float) -> tuple[float, float]:
     return ((col + 0.5) * CELL, (row + 0.5) * CELL)
 
@@ -271,7 +266,7 @@ def scenario_text(name: str, description: str, blocked: np.ndarray, agvs: list[A
         "",
         "[map]",
         f"resolution = {RES}",
-        f'grid = """\n{_grid_text(blocked)}\n"""',
+        f'grid = """\n{grid.to_text()}\n"""',
         "",
         "[planner]",
         'algorithm = "fusion"',
