@@ -187,7 +187,7 @@ class FusionController:
         self._previous = (0.0, 0.0, 0.0)
         self._recovery: Recovery | None = None
         self._recovery_started = ""  # in this cycle, for its ControlStep
-        self._recoveries_done = 0
+        self._recoveries_run: list[str] = []  # the kinds this sequence has started
         self._jam_restarts = 0  # recovery sequences started again in a jam
         self._jammed = False  # another AGV was near at a stall of this sequence
         self._last_stall = -math.inf  # sim time of the last stall
@@ -562,29 +562,30 @@ class FusionController:
 
     def _on_stall(self, position: Point, now: float, moving, walkers) -> PlanResult | None:
         """No progress for ``progress_window``: replan (paper) or the next recovery (default,
-        whose replans go round the discs parked on the route where there is a way; in a jam
-        of AGVs the sequence starts again, ``JAM_RESTARTS`` times, before it fails)."""
+        whose replans go round the discs parked on the route where there is a way; with
+        another AGV near, back off and rotate wait instead; in a jam of AGVs the sequence
+        starts again, ``JAM_RESTARTS`` times, before it fails)."""
         if not self.behaviour.recover:
             plan = self._plan_from(position)
             self._best_remaining, self._best_time = math.inf, now
             return plan
         self._last_stall = now
         self._jammed = self._jammed or _agv_near(position, moving, walkers)
-        exhausted = self._recoveries_done >= len(RECOVERIES)
+        exhausted = len(self._recoveries_run) >= len(RECOVERIES)
         if exhausted and self._jammed and self._jam_restarts < JAM_RESTARTS:
             self._jam_restarts += 1
-            self._recoveries_done, self._jammed = 0, False
+            self._recoveries_run, self._jammed = [], False
         elif exhausted:
             self.status = "failed"
             self.failure = (
-                f"no progress after the recoveries {', '.join(RECOVERIES)} "
+                f"no progress after the recoveries {', '.join(self._recoveries_run)} "
                 f"({self.remaining(position):.1f} m of route left)"
             )
             return None
-        kind = RECOVERIES[self._recoveries_done]
+        kind = RECOVERIES[len(self._recoveries_run)]
         if kind in (BACK_OFF, ROTATE) and _agv_near(position, moving, walkers):
             kind = WAIT  # the others plan too: moving into their room only pushes them
-        self._recoveries_done += 1
+        self._recoveries_run.append(kind)
         self._recovery_started = kind
         plan = self._plan_from(position, moving) if kind == REPLAN else None
         if self.targets:
@@ -670,7 +671,7 @@ class FusionController:
         if remaining < self._best_remaining - self.config.progress_distance:
             self._best_remaining, self._best_time = remaining, now
             if now - self._last_stall >= CALM_WINDOWS * self.config.progress_window:
-                self._recoveries_done = self._jam_restarts = 0
+                self._recoveries_run, self._jam_restarts = [], 0
                 self._jammed = False
             return False
         return now - self._best_time >= self.config.progress_window

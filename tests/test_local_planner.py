@@ -547,9 +547,9 @@ def test_a_stall_among_agvs_is_a_jam_and_the_recoveries_start_again_before_faili
     assert jam > 2.5 * alone  # the sequence ran three times
 
 
-def _recoveries_started(moving: np.ndarray, walkers: np.ndarray) -> list[str]:
+def _recoveries_started(moving: np.ndarray, walkers: np.ndarray) -> tuple[list[str], str]:
     """The recoveries a controller held in place (as ``_fails_at``) starts, in order, until
-    its first sequence has run out."""
+    it fails, and why it failed."""
     grid = parse_text_grid("\n".join(["." * 12] * 12))
     controller = FusionController(grid, (10.5, 6.0), FusionConfig())
     pose = (2.0, 6.0, 0.0)
@@ -558,18 +558,20 @@ def _recoveries_started(moving: np.ndarray, walkers: np.ndarray) -> list[str]:
     for k in range(6000):
         out = controller.step(pose, (0.0, 0.0, 0.0), 0.1 * k, moving, walkers)
         started += [out.recovery] if out.recovery else []
-        if len(started) == len(RECOVERIES):
-            return started
-    return started
+        if out.status == "failed":
+            break
+    return started, controller.failure
 
 
 def test_in_a_jam_the_recoveries_wait_instead_of_backing_off_and_rotating():
     # warehouse-40 n40 s4: agv26's back-off carried it across the cross aisle, among AGVs
     disc = np.array([[2.0, 7.0, 0.0, 0.0, 0.3]])  # 1 m beside the AGV
-    assert _recoveries_started(disc, disc) == list(RECOVERIES)  # a walker: Nav2's sequence
-    in_a_jam = _recoveries_started(disc, np.zeros((0, 5)))  # another AGV
-    assert in_a_jam == [WAIT if r in (BACK_OFF, ROTATE) else r for r in RECOVERIES]
-    assert BACK_OFF in RECOVERIES and ROTATE in RECOVERIES
+    alone, _ = _recoveries_started(disc, disc)  # a walker: Nav2's sequence
+    assert alone == list(RECOVERIES)
+    in_a_jam, why = _recoveries_started(disc, np.zeros((0, 5)))  # another AGV
+    waits = [WAIT if r in (BACK_OFF, ROTATE) else r for r in RECOVERIES]
+    assert waits != list(RECOVERIES) and in_a_jam[: len(RECOVERIES)] == waits
+    assert why.startswith(f"no progress after the recoveries {', '.join(waits)} (")  # as run
 
 
 def test_the_last_metres_to_a_waiting_place_are_driven_straight_not_in_arcs():
