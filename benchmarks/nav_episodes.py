@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fleet.moving_obstacle import MovingObstacle
-from fleet.scenario import AgvSpec, Scenario, TemporaryObstacle
+from fleet.scenario import VEHICLE_KEYS, AgvSpec, Scenario, TemporaryObstacle
 from planner.distance_field import DistanceField
 from planner.dwa import DwaConfig
 from planner.fusion import FusionConfig
@@ -89,9 +89,8 @@ class Episode:
     def toml(self, algorithm: str = "fusion", profile: str = "default") -> str:
         """The episode as a scenario file that ``agv-fleet run`` reads as ``scenario``
         reads it (a test checks they are equal): to watch an episode in Rerun or plot it
-        with ``analyze``. Angles are written in degrees, as the format has them."""
-        vehicle = {k: math.degrees(v) if "omega" in k or "alpha" in k else v
-                   for k, v in VEHICLES[self.vehicle].items()}  # fmt: skip
+        with ``analyze``. The vehicle's limits are written in the format's units."""
+        vehicle = {k: v / VEHICLE_KEYS[k][1] for k, v in VEHICLES[self.vehicle].items()}
         lines = [
             f'name = "nav-{self.seed}"',
             f'description = "nav_bench episode {self.seed}: {self.vehicle} vehicle, '

@@ -570,7 +570,8 @@ class FusionController:
             self._best_remaining, self._best_time = math.inf, now
             return plan
         self._last_stall = now
-        self._jammed = self._jammed or _agv_near(position, moving, walkers)
+        agv_near = _agv_near(position, moving, walkers)
+        self._jammed = self._jammed or agv_near
         exhausted = len(self._recoveries_run) >= len(RECOVERIES)
         if exhausted and self._jammed and self._jam_restarts < JAM_RESTARTS:
             self._jam_restarts += 1
@@ -583,7 +584,7 @@ class FusionController:
             )
             return None
         kind = RECOVERIES[len(self._recoveries_run)]
-        if kind in (BACK_OFF, ROTATE) and _agv_near(position, moving, walkers):
+        if kind in (BACK_OFF, ROTATE) and agv_near:
             kind = WAIT  # the others plan too: moving into their room only pushes them
         self._recoveries_run.append(kind)
         self._recovery_started = kind
