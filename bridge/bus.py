@@ -1,12 +1,12 @@
 """Typed publish/subscribe on a run's keys, with a codec that never crashes a node.
 
-Payloads are compact JSON of ``bridge.messages`` types. Every payload is
-validated before anyone sees it: its size (``MAX_PAYLOAD_BYTES``), JSON
-nesting (Python's parser stops at its recursion limit), every field's type,
-finite numbers, list lengths, and that a message on ``agv/<name>/...`` names
-that AGV. One that fails is counted per key and logged once per key (to the
-node's stderr); the node goes on. Subscribers deliver into a queue so a node
-can wait with a timeout (``recv()`` of zenoh handlers has none).
+Payloads are compact JSON of ``bridge.messages`` types. Every payload is validated
+before anyone sees it: its size (``MAX_PAYLOAD_BYTES``), JSON nesting (Python's parser
+stops at its recursion limit), every field's type, finite numbers, list lengths, and
+that a message on ``agv/<name>/...`` names that AGV (in C by ``bridge.struct_decoder``,
+else by the reference decoder here). One that fails is counted per key and logged once
+per key (to the node's stderr); the node goes on. Subscribers deliver into a queue so a
+node can wait with a timeout (``recv()`` of zenoh handlers has none).
 """
 
 from __future__ import annotations
@@ -16,13 +16,13 @@ import queue
 from collections import Counter
 from dataclasses import dataclass
 
-import orjson
 import zenoh
 
 from bridge import keys
 from bridge.log import say
 from bridge.messages import MessageError, from_dict, to_dict
 from bridge.session import MAX_MESSAGE_BYTES
+from bridge.struct_decoder import decode_valid
 
 MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
 # keys counted one by one; past that, under OTHER_KEYS (a forger picks the keys)
@@ -41,28 +41,25 @@ def decode(key: str, payload: bytes):
         raise MessageError("no message type for this key")
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
-    try:
-        data = _parse(payload)
-    except (ValueError, UnicodeDecodeError) as err:
-        raise MessageError(f"not JSON: {err}"[:200]) from None
-    except RecursionError:
-        raise MessageError("JSON nested too deeply") from None
-    msg = from_dict(cls, data)
+    msg = decode_valid(cls, payload)
+    if msg is None:  # refused by the fast path: the reference decoder decides, and says why
+        msg = _reference_decode(cls, payload)
     owner = keys.agv_name(key)
     if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
     return msg
 
 
-def _parse(payload: bytes):
-    """The JSON value of ``payload``: orjson parses a 100-AGV tick in a third of the json
-    module's time, and every AGV parses every tick. What orjson refuses (NaN, Infinity,
-    lone surrogates, deep nesting) goes to the json module, so each is accepted or refused
-    as it always was, with the same reason."""
+def _reference_decode(cls, payload: bytes):
+    """``cls`` from ``payload`` by the json module and ``from_dict``: slower than the fast
+    path, and the one that names what is wrong."""
     try:
-        return orjson.loads(payload)
-    except orjson.JSONDecodeError:
-        return json.loads(payload)
+        data = json.loads(payload)
+    except (ValueError, UnicodeDecodeError) as err:
+        raise MessageError(f"not JSON: {err}"[:200]) from None
+    except RecursionError:
+        raise MessageError("JSON nested too deeply") from None
+    return from_dict(cls, data)
 
 
 @dataclass

@@ -303,7 +303,7 @@ class _Code:
         return self.env[function]
 
 
-_FLOAT_INT = 2**1023  # ints beyond any float's range do not convert
+FLOAT_INT_LIMIT = 2**1023  # ints beyond any float's range do not convert
 
 
 def _to_float(v, where):
@@ -312,7 +312,7 @@ def _to_float(v, where):
     if type(v) is float:
         if v - v == 0.0:  # not for NaN or an infinity (a call to math.isfinite costs more)
             return v
-    elif type(v) is int and -_FLOAT_INT < v < _FLOAT_INT:
+    elif type(v) is int and -FLOAT_INT_LIMIT < v < FLOAT_INT_LIMIT:
         return float(v)
     raise MessageError(f"{where}: expected a finite number, got {v!r}"[:200])
 
