@@ -20,7 +20,7 @@ import zenoh
 
 from bridge import keys
 from bridge.log import say
-from bridge.messages import MessageError, from_dict, to_dict
+from bridge.messages import MessageError, encode, from_dict
 from bridge.session import MAX_MESSAGE_BYTES
 from bridge.struct_decoder import decode_valid
 
@@ -28,10 +28,6 @@ MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
 # keys counted one by one; past that, under OTHER_KEYS (a forger picks the keys)
 MAX_COUNTED_KEYS = 1000
 OTHER_KEYS = "(other keys)"
-
-
-def encode(msg) -> bytes:
-    return json.dumps(to_dict(msg), separators=(",", ":")).encode()
 
 
 def decode(key: str, payload: bytes):
