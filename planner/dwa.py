@@ -375,12 +375,29 @@ def relevant_discs(
     cost is linear in the number of discs. The nearest come first: ``lower_by_discs``
     then finds a trajectory's clearance early and skips more of the others.
     """
-    if not len(discs):
-        return discs
-    disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * config.horizon_s
-    gap_now = np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
-    (kept,) = np.nonzero(gap_now - agv_reach - disc_reach < bound)
-    return np.ascontiguousarray(discs[kept[np.argsort(gap_now[kept], kind="stable")]])
+    return DiscsByGap(config, pose, agv_reach, discs).within(bound)
+
+
+class DiscsByGap:
+    """Discs sorted nearest first, with the least clearance each can reach within the
+    horizon: ``relevant_discs`` for several bounds from one sort (a control cycle asks
+    for three)."""
+
+    def __init__(self, config: DwaConfig, pose: Pose, agv_reach: float, discs: np.ndarray):
+        if not len(discs):
+            self.discs, self.least = discs, np.zeros(0)
+            return
+        disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * config.horizon_s
+        gap_now = (
+            np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
+        )
+        order = np.argsort(gap_now, kind="stable")
+        self.discs = discs[order]
+        self.least = (gap_now - agv_reach - disc_reach)[order]
+
+    def within(self, bound: float) -> np.ndarray:
+        """The discs whose least clearance is below ``bound``, nearest first."""
+        return np.ascontiguousarray(self.discs[self.least < bound])
 
 
 def admissible_mask(
@@ -599,14 +616,14 @@ class DwaPlanner:
         if lane_room is not None and segment is not None:
             stop_at = target_xy if stop else None
             braking = self._braking_room(commands, pose, command, lane_room, stop_at)
-        every_disc = discs
         # the discs in reach of the fastest sample the lane admits (the fallback's choice
         # between evading and braking looks at them), of which those that can lower a
         # clearance below the best static one
         bound = static_best if braking is None else max(static_best, float(braking.max()))
         span = sample_reach(pose, xs, ys)
-        discs = relevant_discs(cfg, pose, span, every_disc, bound)
-        lowering = relevant_discs(cfg, pose, span, discs, static_best)
+        by_gap = DiscsByGap(cfg, pose, span, discs)
+        discs = by_gap.within(bound)
+        lowering = by_gap.within(static_best)
         if len(lowering):
             clearance = lower_by_discs(xs, ys, clearance, lowering, cfg.dt, cfg.radius)
         offsets = None  # how far each sample strays from the route: the lane and the score
@@ -618,7 +635,7 @@ class DwaPlanner:
             # ever relaxes
             braking = np.where((offsets <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
             # the gap to moving discs bounds the room too (Eq. 7 for them)
-            near = relevant_discs(cfg, pose, span, discs, float(braking.max()))
+            near = by_gap.within(float(braking.max()))
             if len(near):
                 braking = lower_by_discs(xs, ys, braking, near, cfg.dt, cfg.radius)
             braking = np.maximum(braking, clearance)

@@ -15,7 +15,10 @@ def world_velocity(theta, vx, vy, omega, dt: float) -> np.ndarray:
     """
     heading = np.asarray(theta) - np.asarray(omega) * dt
     c, s = np.cos(heading), np.sin(heading)
-    return np.stack((vx * c - vy * s, vx * s + vy * c), axis=-1)
+    out = np.empty((*heading.shape, 2))  # np.stack's result, without its checks
+    out[..., 0] = vx * c - vy * s
+    out[..., 1] = vx * s + vy * c
+    return out
 
 
 Command = tuple[float, float, float]  # body frame: vx, vy (m/s), omega (rad/s)

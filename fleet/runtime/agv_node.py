@@ -10,6 +10,7 @@ call ``on_tick``.
 
 from __future__ import annotations
 
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -159,13 +160,15 @@ class AgvNode:
         """Every other AGV and moving obstacle as (x, y, vx, vy, radius), world frame; one
         array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
         others = [s for s in tick.agvs if s.name != self.name]
-        fields = np.array(
-            [(s.x, s.y, s.theta, s.vx, s.vy, s.omega, s.radius) for s in others], dtype=float
-        ).reshape(-1, 7)
+        fields = np.array(list(map(_STATE_FIELDS, others)), dtype=float).reshape(-1, 7)
         x, y, theta, vx, vy, omega, radius = fields.T
-        velocity = world_velocity(theta, vx, vy, omega, self.scenario.dt)
-        agvs = np.column_stack((x, y, velocity, radius))
-        return np.vstack((agvs, _walkers(tick)))
+        walkers = _walkers(tick)
+        discs = np.empty((len(others) + len(walkers), 5))
+        discs[: len(others), 0], discs[: len(others), 1] = x, y
+        discs[: len(others), 2:4] = world_velocity(theta, vx, vy, omega, self.scenario.dt)
+        discs[: len(others), 4] = radius
+        discs[len(others) :] = walkers
+        return discs
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
@@ -182,6 +185,9 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
     fleet = [a.config.clearance for a in scenario.agvs]
     widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))
     return TrafficGuard(Costmap.for_grid(scenario.grid, widest), controller.config.dwa)
+
+
+_STATE_FIELDS = operator.attrgetter("x", "y", "theta", "vx", "vy", "omega", "radius")
 
 
 def _walkers(tick: Tick) -> np.ndarray:
