@@ -184,7 +184,7 @@ class MessageError(BadInputError, ValueError):
 
 def encode(msg) -> bytes:
     """The message as compact JSON: the bytes on the bus and in recordings, in both run
-    modes. msgspec encodes the dataclasses in C: a 50-AGV tick in 0.14 ms, against 0.8 ms
+    modes. msgspec encodes the dataclasses in C: a 50-AGV tick in 0.1 ms, against 0.65 ms
     for ``json.dumps(to_dict(msg))``. Non-finite numbers come out as ``null``, which no
     decoder takes for a number either."""
     return _ENCODER.encode(msg)

@@ -161,13 +161,14 @@ class AgvNode:
         array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
         others = [s for s in tick.agvs if s.name != self.name]
         fields = np.array(list(map(_STATE_FIELDS, others)), dtype=float).reshape(-1, 7)
-        x, y, theta, vx, vy, omega, radius = fields.T
+        _, _, theta, vx, vy, omega, _ = fields.T
         walkers = _walkers(tick)
-        discs = np.empty((len(others) + len(walkers), 5))
-        discs[: len(others), 0], discs[: len(others), 1] = x, y
-        discs[: len(others), 2:4] = world_velocity(theta, vx, vy, omega, self.scenario.dt)
-        discs[: len(others), 4] = radius
-        discs[len(others) :] = walkers
+        n = len(others)
+        discs = np.empty((n + len(walkers), 5))
+        discs[:n, :2] = fields[:, :2]
+        discs[:n, 2:4] = world_velocity(theta, vx, vy, omega, self.scenario.dt)
+        discs[:n, 4] = fields[:, 6]
+        discs[n:] = walkers
         return discs
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
