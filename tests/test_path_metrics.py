@@ -69,3 +69,36 @@ def test_turn_angle_is_the_heading_change_of_the_three_points_bit_for_bit():
         assert turn_angle(before, node, after) == expected
     assert turn_angle((0.0, 0.0), (1.0, 0.0), (1.0, 1.0)) == math.pi / 2
     assert turn_angle((0.0, 0.0), (1.0, 0.0), (0.0, 0.0)) == math.pi
+
+
+def _crossings_pair_by_pair(pts: np.ndarray, gap: float) -> list[tuple[float, float]]:
+    """``crossing_points`` as its definition reads: every pair of segments, in order."""
+    along = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))))
+    least_sin, found = math.sin(math.radians(30.0)), []
+    for i in range(len(pts) - 1):
+        (ax, ay), (bx, by) = pts[i], pts[i + 1]
+        for j in range(i + 1, len(pts) - 1):
+            if along[j] < along[i + 1] + gap:
+                continue
+            (cx, cy), (dx, dy) = pts[j], pts[j + 1]
+            d1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+            d2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+            d3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+            d4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+            if d1 * d2 < 0 and d3 * d4 < 0:
+                sine = abs(d2 - d1) / (math.hypot(bx - ax, by - ay) * math.hypot(dx - cx, dy - cy))
+                if sine >= least_sin:
+                    t = d1 / (d1 - d2)
+                    found.append((cx + t * (dx - cx), cy + t * (dy - cy)))
+    return found
+
+
+def test_a_long_wandering_path_has_the_crossings_of_every_pair_in_the_same_order():
+    """The block skipping of the compiled search changes nothing: a random walk of 700
+    points (11 blocks, many crossings) against the pair-by-pair definition."""
+    rng = np.random.default_rng(3)
+    heading = np.cumsum(rng.normal(0.0, 0.6, 700))
+    pts = np.cumsum(np.column_stack((np.cos(heading), np.sin(heading))) * 0.4, axis=0)
+    expected = _crossings_pair_by_pair(pts, LOOP_GAP)
+    assert len(expected) > 20
+    assert crossing_points(pts).tolist() == [list(p) for p in expected]
