@@ -21,13 +21,12 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import types
 import typing
 from typing import Annotated, Literal
 
 import msgspec
 
-from bridge.messages import CHOICES, FLOAT_INT_LIMIT, MAX_COUNT, MAX_LIST_ITEMS
+from bridge.messages import CHOICES, FLOAT_INT_LIMIT, MAX_COUNT, MAX_LIST_ITEMS, optional_inner
 
 # strict bounds: from_dict refuses an int of magnitude FLOAT_INT_LIMIT
 _FLOAT = Annotated[float, msgspec.Meta(gt=-float(FLOAT_INT_LIMIT), lt=float(FLOAT_INT_LIMIT))]
@@ -48,17 +47,9 @@ def _decoder(cls):
     return msgspec.json.Decoder(_struct(cls)).decode, _copier(cls)
 
 
-def _optional_inner(hint):
-    """``hint`` without its ``| None``, and whether it had one."""
-    if typing.get_origin(hint) in (typing.Union, types.UnionType):
-        (inner,) = [a for a in typing.get_args(hint) if a is not type(None)]
-        return inner, True
-    return hint, False
-
-
 def _type(hint, choices=None):
     """The msgspec type, with constraints, of a field hinted ``hint``."""
-    inner, optional = _optional_inner(hint)
+    inner, optional = optional_inner(hint)
     if optional:
         return _type(inner) | None
     if typing.get_origin(hint) is list:
@@ -95,7 +86,7 @@ def _copier(cls):
     env = {"cls": cls}
     values = []
     for f in dataclasses.fields(cls):
-        inner, optional = _optional_inner(hints[f.name])
+        inner, optional = optional_inner(hints[f.name])
         value = f"s.{f.name}"
         if typing.get_origin(inner) is list and dataclasses.is_dataclass(typing.get_args(inner)[0]):
             env[f"copy_{f.name}"] = _copier(typing.get_args(inner)[0])
