@@ -64,9 +64,11 @@ import numba
 import numpy as np
 
 from planner.distance_field import DistanceField, lookup
+from planner.dwa_scores import choose
 from planner.evasion import contact_times, evasive_index, into_wall
 from planner.lane_speed import ROUTE_TOLERANCE, braking_room, node_room, stop_room
 from planner.local_behaviour import PAPER_BEHAVIOUR, LocalBehaviour
+from planner.motion import wrap_angle
 from planner.no_retreat import ahead_on_route, retreating
 from planner.yielding import (
     YIELD_SLACK,
@@ -80,6 +82,7 @@ Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
 
 _EPS = 1e-9
+_NO_OFFSETS = np.zeros(0)  # ``choose``'s offsets when the route term is off
 
 
 @dataclass(frozen=True)
@@ -149,11 +152,6 @@ def step_pose(pose: Pose, command: Command, dt: float) -> Pose:
     )
 
 
-def wrap_angle(angle):
-    """Angles wrapped to [-pi, pi)."""
-    return np.remainder(np.asarray(angle) + np.pi, 2 * np.pi) - np.pi
-
-
 @dataclass(frozen=True)
 class DwaResult:
     """The outcome of one control cycle.
@@ -174,6 +172,7 @@ class DwaResult:
         return self.admissible_samples > 0
 
 
+@numba.njit(cache=True)
 def window_axis(current: float, lowest: float, highest: float, reach: float, step: float):
     """One command axis: [lowest, highest] ∩ [current ± reach], on a grid through ``current``.
 
@@ -206,8 +205,8 @@ class Window:
     sample's index into them: what ``rollout`` would otherwise find with ``np.unique``."""
 
     commands: np.ndarray
-    omegas: np.ndarray
     which: np.ndarray
+    omegas: np.ndarray
 
 
 def window(config: DwaConfig, command: Command) -> Window:
@@ -220,15 +219,30 @@ def window(config: DwaConfig, command: Command) -> Window:
         omega, -config.max_omega, config.max_omega, config.max_alpha * config.dt,
         config.omega_resolution,
     )  # fmt: skip
-    grid = np.empty((len(vxs), len(vys), len(omegas), 3))  # meshgrid's product, cheaper
-    grid[..., 0] = vxs[:, None, None]
-    grid[..., 1] = vys[:, None]
-    grid[..., 2] = omegas
-    grid = grid.reshape(-1, 3)
-    kept = np.hypot(grid[:, 0], grid[:, 1]) <= config.max_speed + _EPS
-    # every turn rate is kept with the same speeds: the speed limit drops none of them
-    which = (np.arange(len(grid)) % len(omegas))[kept]
-    return Window(grid[kept], omegas, which)
+    return Window(*_window_grid(vxs, vys, omegas, config.max_speed + _EPS), omegas)
+
+
+@numba.njit(cache=True)
+def _window_grid(vxs, vys, omegas, fastest):
+    """The product of the axes' samples (vx slowest, omega fastest, as ``np.meshgrid``'s
+    with ``indexing="ij"``) without those faster than ``fastest`` in |(vx, vy)|, and each
+    kept sample's index into ``omegas``. Every turn rate is kept with the same speeds:
+    the speed limit drops none of them."""
+    kept = 0
+    for vx in vxs:
+        for vy in vys:
+            kept += np.hypot(vx, vy) <= fastest
+    commands = np.empty((kept * len(omegas), 3))
+    which = np.empty(kept * len(omegas), dtype=np.int64)
+    row = 0
+    for vx in vxs:
+        for vy in vys:
+            if np.hypot(vx, vy) <= fastest:
+                for w in range(len(omegas)):
+                    commands[row, 0], commands[row, 1], commands[row, 2] = vx, vy, omegas[w]
+                    which[row] = w
+                    row += 1
+    return commands, which
 
 
 def braking_command(config: DwaConfig, command: Command) -> Command:
@@ -252,21 +266,27 @@ def rollout(
         omegas, which = np.unique(commands[:, 2], return_inverse=True)
     else:
         omegas, which = samples.omegas, samples.which
-    headings = theta0 + omegas[:, None] * (np.arange(steps + 1) * dt)  # (W, K+1), steps 0..K
-    # the displacement of step k uses the heading at its start (step k-1)
-    cos_sum = np.cumsum(np.cos(headings[:, :-1]), axis=1)
-    sin_sum = np.cumsum(np.sin(headings[:, :-1]), axis=1)
-    return _positions(float(x0), float(y0), commands, which, headings, cos_sum, sin_sum, dt)
+    return _rollout(float(x0), float(y0), float(theta0), commands, omegas, which, dt, steps)
 
 
 @numba.njit(cache=True)
-def _positions(x0, y0, commands, which, headings, cos_sum, sin_sum, dt):
-    """``rollout``'s (3, N, K) from the sums of each distinct omega's headings, in one
-    pass (as numpy computed it elementwise, so bit for bit the same, without six (N, K)
-    temporaries)."""
-    n_commands, steps = commands.shape[0], cos_sum.shape[1]
-    out = np.empty((3, n_commands, steps))
-    for i in range(n_commands):
+def _rollout(x0, y0, theta0, commands, omegas, which, dt, steps):
+    """``rollout``'s (3, N, K) from each distinct turn rate's headings and the cumulative
+    sums of their cosines and sines (in numpy's order, so bit for bit what the array
+    expressions gave), without the (N, K) temporaries."""
+    headings = np.empty((len(omegas), steps + 1))  # steps 0..K
+    cos_sum = np.empty((len(omegas), steps))
+    sin_sum = np.empty((len(omegas), steps))
+    for w in range(len(omegas)):
+        for k in range(steps + 1):
+            headings[w, k] = theta0 + omegas[w] * (k * dt)
+        # the displacement of step k uses the heading at its start (step k - 1)
+        cos_sum[w, 0], sin_sum[w, 0] = np.cos(headings[w, 0]), np.sin(headings[w, 0])
+        for k in range(1, steps):
+            cos_sum[w, k] = cos_sum[w, k - 1] + np.cos(headings[w, k])
+            sin_sum[w, k] = sin_sum[w, k - 1] + np.sin(headings[w, k])
+    out = np.empty((3, len(commands), steps))
+    for i in range(len(commands)):
         w, vx, vy = which[i], commands[i, 0], commands[i, 1]
         for k in range(steps):
             c, s = cos_sum[w, k] * dt, sin_sum[w, k] * dt
@@ -423,63 +443,10 @@ def admissible_mask(
     )
 
 
-def normalised(term: np.ndarray) -> np.ndarray:
-    """``term`` divided by its sum (all zeros when the sum is zero)."""
-    total = term.sum()
-    return term / total if total > 0 else np.zeros_like(term)
-
-
-def scores(
-    config: DwaConfig,
-    commands: np.ndarray,
-    end: tuple[np.ndarray, np.ndarray, np.ndarray],
-    clearance: np.ndarray,
-    target_xy: tuple[float, float],
-    reached: np.ndarray | None = None,
-    extra: np.ndarray | float = 0.0,
-) -> np.ndarray:
-    """Eq. (10) for admissible samples: alpha xhead + beta dist + gamma vel, each normalised.
-
-    ``end`` is the trajectories' final (x, y, theta), ``clearance`` their minimum
-    clearance; ``reached`` marks trajectories that pass the target (full xhead);
-    ``extra`` is added (the default profile's terms, already weighted).
-    """
-    end_x, end_y, end_theta = end
-    bearing = np.arctan2(target_xy[1] - end_y, target_xy[0] - end_x)
-    # an omnidirectional AGV travels at atan2(vy, vx) from its heading: that
-    # direction, not the body heading, is what must point at the target
-    moving = np.hypot(commands[:, 0], commands[:, 1]) > _EPS
-    travel = end_theta + np.where(moving, np.arctan2(commands[:, 1], commands[:, 0]), 0.0)
-    xhead = np.pi - np.abs(wrap_angle(bearing - travel))
-    if reached is not None:
-        xhead = np.where(reached, np.pi, xhead)
-    dist = np.minimum(clearance, config.clearance_cap)
-    vel = np.hypot(commands[:, 0], commands[:, 1])
-    return (
-        config.alpha * normalised(xhead)
-        + config.beta * normalised(dist)
-        + config.gamma * normalised(vel)
-        + extra
-    )
-
-
-def facing(commands: np.ndarray) -> np.ndarray:
-    """pi - the angle between the body heading and the travel direction (pi when standing)."""
-    moving = np.hypot(commands[:, 0], commands[:, 1]) > _EPS
-    return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
-
-
 def route_offsets(xs: np.ndarray, ys: np.ndarray, segment) -> np.ndarray:
     """(N,) the largest distance of each trajectory (N, K) from the route ``segment``."""
     (ax, ay), (bx, by) = segment
     return _largest_offsets(xs, ys, float(ax), float(ay), float(bx - ax), float(by - ay))
-
-
-def on_route(offsets: np.ndarray, cap: float) -> np.ndarray:
-    """cap - each trajectory's ``route_offsets`` (capped at ``cap``): trajectories that stay
-    on the global route score highest, so the AGV lines up with a narrow passage the route
-    goes through before it gets there."""
-    return cap - np.minimum(offsets, cap)
 
 
 @numba.njit(cache=True)
@@ -507,49 +474,6 @@ def _largest_offsets(xs, ys, ax, ay, dx, dy):
                 largest = max(largest, math.hypot(ex[k], ey[k]))
         out[n] = largest
     return out
-
-
-def jerk(commands: np.ndarray, command: Command, previous: Command) -> np.ndarray:
-    """(N,) how much each sample changes the last cycle's acceleration, in m/s per period.
-
-    Linear axes: |(sample - command) - (command - previous)|; omega adds the
-    same change times the speed, since a turn rate change of dw changes the
-    world-frame velocity by speed x dw.
-    """
-    keep = 2.0 * np.asarray(command) - np.asarray(previous)
-    speed = math.hypot(command[0], command[1])
-    return np.hypot(commands[:, 0] - keep[0], commands[:, 1] - keep[1]) + speed * np.abs(
-        commands[:, 2] - keep[2]
-    )
-
-
-def steady_choice(
-    score: np.ndarray,
-    change: np.ndarray,
-    tolerance: float,
-    speeds: np.ndarray,
-    speed: float,
-    step: float,
-) -> int:
-    """The sample of least ``change`` among those scoring within ``tolerance`` of the best.
-
-    ``tolerance`` is a fraction of the scores' spread. The normalised scores
-    of neighbouring samples differ by little, so the plain argmax hops
-    between them every cycle and the acceleration flips; preferring the
-    steadiest near-best sample keeps the acceleration unless a clearly
-    better command exists. But when the best sample is faster than the
-    current ``speed``, only near-best samples at least ``step`` faster count:
-    the speed term, divided by its sum over thousands of samples, differs by
-    less than the tolerance between neighbouring speeds, so without this the
-    choice kept a crawl (0.14 m/s for 90 s in a 1.0 m corridor whose Eq. 7
-    limit is 0.45 m/s).
-    """
-    top = float(score.max())
-    near = np.flatnonzero(score >= top - tolerance * (top - float(score.min())))
-    if speeds[int(np.argmax(score))] > speed + step:
-        faster = near[speeds[near] >= speed + step]
-        near = faster if faster.size else near
-    return int(near[np.lexsort((-score[near], change[near]))[0]])
 
 
 class DwaPlanner:
@@ -668,41 +592,22 @@ class DwaPlanner:
             brake = braking_command(cfg, command)
             path = rollout(pose, np.array([brake]), cfg.dt, cfg.steps)[:, 0, :]
             return DwaResult(brake, _poses(path), len(commands), 0)
-        end = (xs[ok, -1], ys[ok, -1], thetas[ok, -1])
-        reached = None
-        if reach > 0:
-            gap2 = (xs[ok] - target_xy[0]) ** 2 + (ys[ok] - target_xy[1]) ** 2
-            reached = gap2.min(axis=1) <= reach * reach
-        room = clearance[ok]
-        if approach:  # nearness to the target in place of clearance
-            room = cfg.clearance_cap - np.minimum(
-                np.hypot(end[0] - target_xy[0], end[1] - target_xy[1]), cfg.clearance_cap
-            )
-        g = scores(
-            cfg,
-            commands[ok],
-            end,
-            room,
-            target_xy,
-            reached,
-            self._extra(commands[ok]),
-        )
-        if segment is not None and self.behaviour.route_weight > 0:
-            g = g + self.behaviour.route_weight * normalised(
-                on_route(offsets[ok], cfg.clearance_cap)
-            )
-        standing = math.hypot(command[0], command[1]) < _EPS
-        if self.behaviour.steady_tolerance > 0 and not standing:  # at rest: nothing to keep
-            change = jerk(commands[ok], command, command if previous is None else previous)
-            speeds = np.hypot(commands[ok, 0], commands[ok, 1])
-            current = math.hypot(command[0], command[1])
-            # with a walker coming the AGV keeps the room to yield: no speeding up out of the
-            # tolerance
-            step = math.inf if walker_coming(pose, walkers) else cfg.v_resolution
-            pick = steady_choice(g, change, self.behaviour.steady_tolerance, speeds, current, step)
-            best = ok[pick]
-        else:
-            best = ok[int(np.argmax(g))]
+        behaviour = self.behaviour
+        route_weight = behaviour.route_weight if offsets is not None else 0.0
+        weights = (cfg.alpha, cfg.beta, cfg.gamma, behaviour.face_travel_weight, route_weight)
+        speed = math.hypot(command[0], command[1])
+        steady = behaviour.steady_tolerance
+        # with a walker coming the AGV keeps the room to yield: no speeding up out of the
+        # steady choice's tolerance
+        step = cfg.v_resolution
+        if steady > 0 and speed >= _EPS and walker_coming(pose, walkers):
+            step = math.inf
+        best = choose(
+            ok, commands, xs, ys, thetas, clearance, _NO_OFFSETS if offsets is None else offsets,
+            float(target_xy[0]), float(target_xy[1]), float(reach), approach, weights,
+            cfg.clearance_cap, steady, command, command if previous is None else previous,
+            speed, step,
+        )  # fmt: skip
         chosen = tuple(float(v) for v in commands[best])
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
 
@@ -775,11 +680,6 @@ class DwaPlanner:
             xs, ys, field.samples, 1.0 / field.spacing, discs, cfg.dt, cfg.radius, *field.origin
         )
         return bool(np.isfinite(moving_first[0]))
-
-    def _extra(self, commands: np.ndarray):
-        """The default profile's facing term for the admissible ``commands``, weighted."""
-        weight = self.behaviour.face_travel_weight
-        return weight * normalised(facing(commands)) if weight > 0 else 0.0
 
 
 def _poses(path) -> np.ndarray:

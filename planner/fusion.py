@@ -46,12 +46,13 @@ from planner.agv_status import BACK_OFF, REPLAN, ROTATE, WAIT, WAITING
 from planner.clearance import Clearance
 from planner.costmap import Costmap
 from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner, braking_command, wrap_angle
+from planner.dwa import DwaConfig, DwaPlanner, braking_command
 from planner.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
 from planner.grid_map import Cell, GridMap, MapError, Point, cells_in_disc
 from planner.keep_right import agv_coming, right_offset, shifted_right
 from planner.lane_speed import oncoming, route_room
 from planner.local_behaviour import local_behaviour
+from planner.motion import wrap_angle
 from planner.parked_discs import blocking_cells
 from planner.passed_node import in_plain_sight, passed_beside
 from planner.path_metrics import distance_to_path

@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+import numba
 import numpy as np
+
+
+@numba.vectorize(["float64(float64)"], cache=True)
+def wrap_angle(angle):
+    """Angles wrapped to [-pi, pi) (scalars or arrays; callable from compiled code)."""
+    return np.remainder(angle + np.pi, 2 * np.pi) - np.pi
 
 
 def world_velocity(theta, vx, vy, omega, dt: float) -> np.ndarray:

@@ -15,7 +15,6 @@ from planner.dwa import (
     braking_command,
     dynamic_window,
     lower_by_discs,
-    on_route,
     rollout,
     route_offsets,
     sample_reach,
@@ -24,6 +23,7 @@ from planner.dwa import (
     window,
     window_axis,
 )
+from planner.dwa_scores import on_route, pairwise_sum, steady_choice
 from planner.grid_map import GridMap
 
 CFG = DwaConfig()
@@ -343,3 +343,22 @@ def test_without_reach_plain_dwa_overshoots_a_close_target():
         command = planner.plan(pose, command, goal).command
         pose = step_pose(pose, command, CFG.dt)
     assert math.dist(pose[:2], goal) > 0.2  # it does not stay at the target
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1.0, 1e3])
+def test_compiled_sums_equal_numpys_bit_for_bit(scale):
+    """The compiled scores divide by sums; a sum in another order (a plain loop) differs
+    in the last bits and can flip a choice between near-equal samples."""
+    rng = np.random.default_rng(7)
+    for n in [*range(0, 300), 1000, 4099]:
+        values = rng.random(n) * scale * rng.choice([1e-6, 1.0, 1e6], n)
+        assert pairwise_sum(values) == values.sum(), n
+    plain = rng.random(1000)
+    assert sum(plain.tolist()) != plain.sum()  # the order matters for these values
+
+
+def test_the_steady_choice_breaks_ties_by_score_then_first():
+    score = np.array([1.0, 0.99, 0.995, 0.995, 0.2])
+    change = np.array([0.5, 0.1, 0.1, 0.1, 0.0])
+    # within 10 % of the spread of the best: 0..3; least change: 1, 2, 3; best score: 2, 3
+    assert steady_choice(score, change, 0.1, np.zeros(5), 0.0, 0.01) == 2
