@@ -63,6 +63,7 @@ from dataclasses import dataclass, fields
 import numba
 import numpy as np
 
+from planner.cpython_math import remainder
 from planner.distance_field import DistanceField, lookup
 from planner.dwa_scores import choose
 from planner.evasion import contact_times, evasive_index, into_wall
@@ -140,15 +141,17 @@ class DwaConfig:
         return self.steps * self.dt
 
 
+@numba.njit(cache=True)
 def step_pose(pose: Pose, command: Command, dt: float) -> Pose:
-    """Eq. (4): ``pose`` after ``dt`` under the body-frame ``command``, theta in [-pi, pi]."""
+    """Eq. (4): ``pose`` after ``dt`` under the body-frame ``command``, theta in [-pi, pi]
+    (compiled: the straight approach's rollout calls it from compiled code)."""
     x, y, theta = pose
     vx, vy, omega = command
     c, s = math.cos(theta), math.sin(theta)
     return (
         x + (vx * c - vy * s) * dt,
         y + (vx * s + vy * c) * dt,
-        math.remainder(theta + omega * dt, math.tau),
+        remainder(theta + omega * dt, math.tau),
     )
 
 

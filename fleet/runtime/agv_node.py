@@ -24,6 +24,7 @@ from planner.costmap import Costmap
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
 from planner.motion import world_velocity
+from planner.tight_turns import approach_path
 from planner.traffic_guard import TrafficGuard
 
 
@@ -71,6 +72,7 @@ class AgvNode:
         walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
         dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, walker)
         dwa.threatened((*start, 0.0), walker)
+        approach_path(dwa.config, (*start, 0.0), (0.0, 0.0, 0.0), goal, dwa.config.max_speed)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""
