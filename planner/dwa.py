@@ -407,20 +407,22 @@ class DiscsByGap:
     for three)."""
 
     def __init__(self, config: DwaConfig, pose: Pose, agv_reach: float, discs: np.ndarray):
-        if not len(discs):
-            self.discs, self.least = discs, np.zeros(0)
-            return
-        disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * config.horizon_s
-        gap_now = (
-            np.hypot(discs[:, 0] - pose[0], discs[:, 1] - pose[1]) - discs[:, 4] - config.radius
-        )
-        order = np.argsort(gap_now, kind="stable")
-        self.discs = discs[order]
-        self.least = (gap_now - agv_reach - disc_reach)[order]
+        x, y = float(pose[0]), float(pose[1])
+        self.discs, self.least = _by_gap(discs, x, y, agv_reach, config.radius, config.horizon_s)
 
     def within(self, bound: float) -> np.ndarray:
         """The discs whose least clearance is below ``bound``, nearest first."""
         return np.ascontiguousarray(self.discs[self.least < bound])
+
+
+@numba.njit(cache=True)
+def _by_gap(discs, x, y, agv_reach, radius, horizon_s):
+    """``DiscsByGap``'s discs and least clearances, compiled (stable sort: ties keep
+    their order)."""
+    disc_reach = np.hypot(discs[:, 2], discs[:, 3]) * horizon_s
+    gap_now = np.hypot(discs[:, 0] - x, discs[:, 1] - y) - discs[:, 4] - radius
+    order = np.argsort(gap_now, kind="mergesort")
+    return discs[order], (gap_now - agv_reach - disc_reach)[order]
 
 
 def admissible_mask(
@@ -434,16 +436,23 @@ def admissible_mask(
     ``braking_room`` (the default profile's ``planner.lane_speed``) replaces the
     clearance in the linear speed's bound; the turn rate's bound keeps the clearance.
     """
-    room = np.maximum(clearance, 0.0)
-    linear = room if braking_room is None else np.maximum(braking_room, 0.0)
-    return (
-        (clearance > 0.0)
-        & (
-            np.hypot(commands[:, 0], commands[:, 1])
-            <= np.sqrt(2.0 * linear * config.max_accel) + _EPS
+    linear = clearance if braking_room is None else braking_room
+    return _admissible(commands, clearance, linear, config.max_accel, config.max_alpha)
+
+
+@numba.njit(cache=True)
+def _admissible(commands, clearance, linear, max_accel, max_alpha):
+    """``admissible_mask``, compiled: ``linear`` is the room bounding the linear speed."""
+    mask = np.empty(len(commands), dtype=np.bool_)
+    for i in range(len(commands)):
+        room = max(clearance[i], 0.0)
+        speed = np.hypot(commands[i, 0], commands[i, 1])
+        mask[i] = (
+            clearance[i] > 0.0
+            and speed <= np.sqrt(2.0 * max(linear[i], 0.0) * max_accel) + _EPS
+            and abs(commands[i, 2]) <= np.sqrt(2.0 * room * max_alpha) + _EPS
         )
-        & (np.abs(commands[:, 2]) <= np.sqrt(2.0 * room * config.max_alpha) + _EPS)
-    )
+    return mask
 
 
 def route_offsets(xs: np.ndarray, ys: np.ndarray, segment) -> np.ndarray:

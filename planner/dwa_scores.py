@@ -95,22 +95,26 @@ def speeds_of(commands):
 
 
 @numba.njit(cache=True)
-def xhead(commands, end_x, end_y, end_theta, target_x, target_y):
-    """Eq. (10)'s heading term: pi - |error| between the bearing from the trajectory's end
-    to the target and the direction of travel. An omnidirectional AGV travels at
-    atan2(vy, vx) from its heading: that direction, not the body heading, is what must
-    point at the target (the body heading when standing)."""
-    bearing = np.arctan2(target_y - end_y, target_x - end_x)
-    moving = speeds_of(commands) > _EPS
-    travel = end_theta + np.where(moving, np.arctan2(commands[:, 1], commands[:, 0]), 0.0)
-    return np.pi - np.abs(wrap_angle(bearing - travel))
+def travel_angles(commands, speeds):
+    """(N,) each sample's direction of travel off the body heading, atan2(vy, vx) (0 when
+    standing): an omnidirectional AGV need not face where it goes. ``speeds``:
+    ``speeds_of(commands)``."""
+    return np.where(speeds > _EPS, np.arctan2(commands[:, 1], commands[:, 0]), 0.0)
 
 
 @numba.njit(cache=True)
-def facing(commands):
-    """pi - the angle between the body heading and the travel direction (pi when standing)."""
-    moving = speeds_of(commands) > _EPS
-    return np.pi - np.where(moving, np.abs(np.arctan2(commands[:, 1], commands[:, 0])), 0.0)
+def xhead(travel, end_x, end_y, end_theta, target_x, target_y):
+    """Eq. (10)'s heading term: pi - |error| between the bearing from the trajectory's end
+    to the target and the direction of travel (``travel_angles`` off the end heading):
+    that direction, not the body heading, is what must point at the target."""
+    bearing = np.arctan2(target_y - end_y, target_x - end_x)
+    return np.pi - np.abs(wrap_angle(bearing - (end_theta + travel)))
+
+
+@numba.njit(cache=True)
+def facing(travel):
+    """pi - the angle between the body heading and the direction of travel (pi standing)."""
+    return np.pi - np.abs(travel)
 
 
 @numba.njit(cache=True)
@@ -190,7 +194,9 @@ def choose(
     alpha, beta, gamma, face_weight, route_weight = weights
     sampled = commands[ok]
     end_x, end_y, end_theta = xs[ok, -1], ys[ok, -1], thetas[ok, -1]
-    head = xhead(sampled, end_x, end_y, end_theta, target_x, target_y)
+    speeds = speeds_of(sampled)
+    travel = travel_angles(sampled, speeds)
+    head = xhead(travel, end_x, end_y, end_theta, target_x, target_y)
     if reach > 0:
         gap_x, gap_y = xs[ok] - target_x, ys[ok] - target_y
         reached = np.empty(ok.size, dtype=np.bool_)
@@ -201,14 +207,13 @@ def choose(
         room = cap - np.minimum(np.hypot(end_x - target_x, end_y - target_y), cap)
     else:
         room = clearance[ok]
-    speeds = speeds_of(sampled)
     score = (
         alpha * normalised(head)
         + beta * normalised(np.minimum(room, cap))
         + gamma * normalised(speeds)
     )
     if face_weight > 0:
-        score = score + face_weight * normalised(facing(sampled))
+        score = score + face_weight * normalised(facing(travel))
     if route_weight > 0:
         score = score + route_weight * normalised(on_route(offsets[ok], cap))
     if steady > 0 and speed >= _EPS:  # at rest: nothing to keep

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from planner.distance_field import DistanceField
@@ -72,9 +73,24 @@ def agv_coming(position: Point, segment, radius: float, agvs, reach: float = REA
     if agvs is None or not len(agvs) or length < 1e-9:
         return False
     hx, hy = (bx - ax) / length, (by - ay) / length
-    along = (agvs[:, 0] - position[0]) * hx + (agvs[:, 1] - position[1]) * hy
-    across = np.abs((agvs[:, 1] - ay) * hx - (agvs[:, 0] - ax) * hy)
-    their_speed = np.hypot(agvs[:, 2], agvs[:, 3])
-    against = agvs[:, 2] * hx + agvs[:, 3] * hy < math.cos(HEAD_ON) * their_speed
-    coming = (their_speed > 1e-3) & against & (along > -PASSED) & (along < reach)
-    return bool((coming & (across < radius + agvs[:, 4] + GAP)).any())
+    agvs = np.ascontiguousarray(agvs, dtype=float)
+    px, py = float(position[0]), float(position[1])
+    return _coming(agvs, px, py, float(ax), float(ay), float(hx), float(hy), radius, reach)
+
+
+_COS_HEAD_ON = math.cos(HEAD_ON)
+
+
+@numba.njit(cache=True)
+def _coming(agvs, px, py, ax, ay, hx, hy, radius, reach):
+    """``agv_coming``'s test of each AGV, compiled (it runs every control cycle)."""
+    for i in range(agvs.shape[0]):
+        x, y, vx, vy, r = agvs[i, 0], agvs[i, 1], agvs[i, 2], agvs[i, 3], agvs[i, 4]
+        along = (x - px) * hx + (y - py) * hy
+        across = abs((y - ay) * hx - (x - ax) * hy)
+        their_speed = np.hypot(vx, vy)
+        against = vx * hx + vy * hy < _COS_HEAD_ON * their_speed
+        coming = their_speed > 1e-3 and against and along > -PASSED and along < reach
+        if coming and across < radius + r + GAP:
+            return True
+    return False

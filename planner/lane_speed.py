@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from planner.distance_field import DistanceField
@@ -100,13 +101,22 @@ def oncoming(pose, command, moving, max_accel: float, horizon_s: float) -> bool:
     for their 0.4 m gap, and wove about as they passed."""
     if moving is None or not len(moving):
         return False
-    discs = np.asarray(moving, dtype=float).reshape(-1, 5)
+    discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
     vx, vy = world_velocity(pose[2], command[0], command[1], 0.0, 0.0)  # as it drives on
-    dx, dy = discs[:, 0] - pose[0], discs[:, 1] - pose[1]
-    distance = np.maximum(np.hypot(dx, dy), 1e-9)
-    closing = ((vx - discs[:, 2]) * dx + (vy - discs[:, 3]) * dy) / distance
     lead = math.hypot(vx, vy) / max_accel + horizon_s  # s: braking, then a horizon's look
-    return bool(((closing > 0.0) & (distance < closing * lead)).any())
+    return _closing_in_time(discs, float(pose[0]), float(pose[1]), float(vx), float(vy), lead)
+
+
+@numba.njit(cache=True)
+def _closing_in_time(discs, x, y, vx, vy, lead):
+    """``oncoming``'s test of each disc, compiled (it runs every control cycle)."""
+    for i in range(discs.shape[0]):
+        dx, dy = discs[i, 0] - x, discs[i, 1] - y
+        distance = max(np.hypot(dx, dy), 1e-9)
+        closing = ((vx - discs[i, 2]) * dx + (vy - discs[i, 3]) * dy) / distance
+        if closing > 0.0 and distance < closing * lead:
+            return True
+    return False
 
 
 def stop_room(distance: float, behind: float, speed: np.ndarray, horizon_s: float) -> np.ndarray:

@@ -209,25 +209,20 @@ class Passages:
         (its last sample inside before a stretch longer than a waiting place outside) is
         found on the whole route."""
         cells = route if isinstance(route, RouteCells) else self.route_cells(route)
-        ahead = cells.along >= start_at - self.grid.resolution / 2
-        if not ahead.any():
+        behind = start_at - self.grid.resolution / 2
+        first, last, ahead, along = _crossing_span(
+            cells.along, cells.labels, start_at, behind, lookahead, self.join_distance
+        )
+        if first < 0:
             return None
-        along = np.maximum(cells.along[ahead] - start_at, 0.0)
-        cols, rows = cells.cols[ahead], cells.rows[ahead]
-        inside, labels = cells.inside[ahead], cells.labels[ahead]
-        hits = np.flatnonzero(labels != NONE)
-        if not len(hits) or along[hits[0]] > lookahead:
-            return None
-        first = int(hits[0])
-        passage = int(labels[first])
-        mine = np.flatnonzero(labels == passage)
-        gaps = np.flatnonzero(np.diff(along[mine]) > self.join_distance)
-        last = int(mine[gaps[0]] if len(gaps) else mine[-1])
+        passage = int(cells.labels[ahead[first]])
         exit = entry = None
-        if last + 1 < len(labels) and inside[last + 1]:
-            exit = self._mouth_near(int(cols[last + 1]), int(rows[last + 1]), passage)
-        if first > 0 and inside[first - 1]:
-            entry = self._mouth_near(int(cols[first - 1]), int(rows[first - 1]), passage)
+        if last + 1 < len(ahead) and cells.inside[ahead[last + 1]]:
+            after = ahead[last + 1]
+            exit = self._mouth_near(int(cells.cols[after]), int(cells.rows[after]), passage)
+        if first > 0 and cells.inside[ahead[first - 1]]:
+            before = ahead[first - 1]
+            entry = self._mouth_near(int(cells.cols[before]), int(cells.rows[before]), passage)
         return Crossing(passage, float(along[first]), float(along[last]), exit, entry)
 
     def _mouth_near(self, col: int, row: int, passage: int) -> int | None:
@@ -248,6 +243,31 @@ class Passages:
             if inside and self.mouth[r, c] != NONE and _touches(self.label, c, r, passage):
                 return int(self.mouth[r, c])
         return None
+
+
+@numba.njit(cache=True)
+def _crossing_span(along, labels, start_at, behind, lookahead, join):
+    """``first_crossing``'s search, compiled (it runs every tick for every AGV): the
+    samples from ``behind`` on (``ahead``, indices into the route's samples) and their
+    distance from ``start_at`` (``clipped``, >= 0); ``first``, the first of them in a
+    passage within ``lookahead``, and ``last``, that passage's last sample before a
+    stretch longer than ``join`` outside it, both indices into ``ahead``; -1, -1 if none."""
+    ahead = np.flatnonzero(along >= behind)
+    clipped = np.maximum(along[ahead] - start_at, 0.0)
+    first = -1
+    for i in range(ahead.size):
+        if labels[ahead[i]] != NONE:
+            first = i
+            break
+    if first < 0 or clipped[first] > lookahead:
+        return -1, -1, ahead, clipped
+    passage, last = labels[ahead[first]], first
+    for i in range(first + 1, ahead.size):
+        if labels[ahead[i]] == passage:
+            if clipped[i] - clipped[last] > join:
+                break
+            last = i
+    return first, last, ahead, clipped
 
 
 def _samples(route: list[Point], step: float) -> tuple[np.ndarray, np.ndarray]:

@@ -10,6 +10,7 @@ call ``on_tick``.
 
 from __future__ import annotations
 
+import itertools
 import operator
 from dataclasses import dataclass
 
@@ -162,10 +163,12 @@ class AgvNode:
         """Every other AGV and moving obstacle as (x, y, vx, vy, radius), world frame; one
         array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
         others = [s for s in tick.agvs if s.name != self.name]
-        fields = np.array(list(map(_STATE_FIELDS, others)), dtype=float).reshape(-1, 7)
+        n = len(others)
+        values = itertools.chain.from_iterable(map(_STATE_FIELDS, others))  # np.array of
+        # the rows took half as long again: it inspects each row's shape
+        fields = np.fromiter(values, dtype=float, count=7 * n).reshape(n, 7)
         _, _, theta, vx, vy, omega, _ = fields.T
         walkers = _walkers(tick)
-        n = len(others)
         discs = np.empty((n + len(walkers), 5))
         discs[:n, :2] = fields[:, :2]
         discs[:n, 2:4] = world_velocity(theta, vx, vy, omega, self.scenario.dt)
