@@ -214,3 +214,5 @@ def warm_up() -> None:
     for algorithm in ALGORITHMS:
         for profile in (PAPER, DEFAULT):
             plan_global(grid, (0.5, 0.5), (2.5, 1.5), algorithm, profile=profile)
+    # a straight route has no inner key node to centre: the centring kernel, too
+    centred(grid.blocked, np.array([[0.5, 0.5], [1.5, 0.5], [2.5, 1.5]]), 1.0, 1.0)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 RETREAT_ANGLE = math.radians(100.0)
@@ -61,8 +62,21 @@ def ahead_on_route(pose, target, segment) -> tuple[float, float]:
 def retreating(pose, end_x: np.ndarray, end_y: np.ndarray, target) -> np.ndarray:
     """(N,) whether each sample, from ``pose`` to its end point (``end_x``, ``end_y``),
     drives away from ``target``."""
-    dx, dy = end_x - pose[0], end_y - pose[1]
-    tx, ty = target[0] - pose[0], target[1] - pose[1]
-    shift = np.hypot(dx, dy)
-    towards = dx * tx + dy * ty
-    return (shift > STANDING) & (towards < math.cos(RETREAT_ANGLE) * shift * math.hypot(tx, ty))
+    x, y = float(pose[0]), float(pose[1])
+    tx, ty = target[0] - x, target[1] - y
+    end_x, end_y = np.ascontiguousarray(end_x, float), np.ascontiguousarray(end_y, float)
+    return _away(end_x, end_y, x, y, tx, ty, math.hypot(tx, ty))
+
+
+_COS_RETREAT = math.cos(RETREAT_ANGLE)
+
+
+@numba.njit(cache=True)
+def _away(end_x, end_y, x, y, tx, ty, target_distance):
+    """``retreating``, compiled (it runs every control cycle on every sample)."""
+    out = np.empty(end_x.size, dtype=np.bool_)
+    for i in range(end_x.size):
+        dx, dy = end_x[i] - x, end_y[i] - y
+        shift = np.hypot(dx, dy)
+        out[i] = shift > STANDING and dx * tx + dy * ty < _COS_RETREAT * shift * target_distance
+    return out

@@ -22,10 +22,14 @@ from fleet.scenario import Scenario
 from planner.agv_status import FAILED, FINISHED
 from planner.clearance import Clearance
 from planner.costmap import Costmap
+from planner.dwa import step_pose
 from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
-from planner.motion import world_velocity
-from planner.tight_turns import approach_path
+from planner.keep_right import agv_coming
+from planner.lane_speed import oncoming
+from planner.motion import world_velocity, wrap_angle
+from planner.no_retreat import retreating
+from planner.tight_turns import approach_command, approach_path
 from planner.traffic_guard import TrafficGuard
 
 
@@ -68,12 +72,25 @@ class AgvNode:
         AGVs on 2 cores, 0.8 s of the start-up). The node is spent: a throwaway."""
         warm_up()
         start, goal, dwa = self.spec.start, self.spec.goal, self.controller.dwa
-        self.controller.start((*start, 0.0))
-        dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, segment=(start, goal))
+        pose, rest, cfg = (*start, 0.0), (0.0, 0.0, 0.0), dwa.config
+        self.controller.start(pose)
+        dwa.plan(pose, rest, goal, segment=(start, goal))
         walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
-        dwa.plan((*start, 0.0), (0.0, 0.0, 0.0), goal, walker)
-        dwa.threatened((*start, 0.0), walker)
-        approach_path(dwa.config, (*start, 0.0), (0.0, 0.0, 0.0), goal, dwa.config.max_speed)
+        dwa.plan(pose, rest, goal, walker)
+        dwa.threatened(pose, walker)
+        # what a control cycle calls from Python beyond DWA (each signature is loaded
+        # once per process: in each of 50 forked AGV processes it cost the first ticks)
+        coming = np.array([[*goal, -0.5, 0.0, cfg.radius]])  # an AGV head-on
+        agv_coming(start, (start, goal), cfg.radius, coming)
+        oncoming(pose, (0.5, 0.0, 0.0), coming, cfg.max_accel, cfg.horizon_s)
+        retreating(pose, np.zeros(2), np.zeros(2), goal)
+        approach_path(cfg, pose, rest, goal, cfg.max_speed)
+        approach_command(cfg, pose, rest, goal, cfg.max_speed)
+        step_pose(pose, rest, cfg.dt)
+        wrap_angle(0.0)
+        dwa.distance_field.distance_at(*start)
+        if self.guard is not None:
+            self.guard.passages.first_crossing([start, goal], 1.0)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""
