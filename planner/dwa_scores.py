@@ -5,6 +5,9 @@ One control cycle scores a few hundred samples. As numpy expressions these were 
 thirty small array operations, each paying Python's and numpy's call overhead; compiled
 they are one call. Every operation is the one numpy did, in the same order, and sums
 follow numpy's pairwise order (``pairwise_sum``), so the choice is the same bit for bit.
+They are written as loops: numba compiled the array expressions (broadcasting, fancy
+indexing) four times slower, and a fresh install compiles every kernel before its first
+run.
 """
 
 from __future__ import annotations
@@ -85,13 +88,20 @@ def pairwise_sum(values):
 def normalised(term):
     """``term`` divided by its sum (all zeros when the sum is zero)."""
     total = pairwise_sum(term)
-    return term / total if total > 0 else np.zeros_like(term)
+    out = np.zeros(term.size)
+    if total > 0:
+        for i in range(term.size):
+            out[i] = term[i] / total
+    return out
 
 
 @numba.njit(cache=True)
 def speeds_of(commands):
     """(N,) |(vx, vy)| of (N, 3) commands."""
-    return np.hypot(commands[:, 0], commands[:, 1])
+    out = np.empty(len(commands))
+    for i in range(len(commands)):
+        out[i] = np.hypot(commands[i, 0], commands[i, 1])
+    return out
 
 
 @numba.njit(cache=True)
@@ -99,7 +109,11 @@ def travel_angles(commands, speeds):
     """(N,) each sample's direction of travel off the body heading, atan2(vy, vx) (0 when
     standing): an omnidirectional AGV need not face where it goes. ``speeds``:
     ``speeds_of(commands)``."""
-    return np.where(speeds > _EPS, np.arctan2(commands[:, 1], commands[:, 0]), 0.0)
+    out = np.zeros(len(commands))
+    for i in range(len(commands)):
+        if speeds[i] > _EPS:
+            out[i] = np.arctan2(commands[i, 1], commands[i, 0])
+    return out
 
 
 @numba.njit(cache=True)
@@ -107,14 +121,20 @@ def xhead(travel, end_x, end_y, end_theta, target_x, target_y):
     """Eq. (10)'s heading term: pi - |error| between the bearing from the trajectory's end
     to the target and the direction of travel (``travel_angles`` off the end heading):
     that direction, not the body heading, is what must point at the target."""
-    bearing = np.arctan2(target_y - end_y, target_x - end_x)
-    return np.pi - np.abs(wrap_angle(bearing - (end_theta + travel)))
+    out = np.empty(travel.size)
+    for i in range(travel.size):
+        bearing = np.arctan2(target_y - end_y[i], target_x - end_x[i])
+        out[i] = np.pi - abs(wrap_angle(bearing - (end_theta[i] + travel[i])))
+    return out
 
 
 @numba.njit(cache=True)
 def facing(travel):
     """pi - the angle between the body heading and the direction of travel (pi standing)."""
-    return np.pi - np.abs(travel)
+    out = np.empty(travel.size)
+    for i in range(travel.size):
+        out[i] = np.pi - abs(travel[i])
+    return out
 
 
 @numba.njit(cache=True)
@@ -122,7 +142,10 @@ def on_route(offsets, cap):
     """cap - each trajectory's ``route_offsets`` (capped at ``cap``): trajectories that stay
     on the global route score highest, so the AGV lines up with a narrow passage the route
     goes through before it gets there."""
-    return cap - np.minimum(offsets, cap)
+    out = np.empty(offsets.size)
+    for i in range(offsets.size):
+        out[i] = cap - min(offsets[i], cap)
+    return out
 
 
 @numba.njit(cache=True)
@@ -136,9 +159,21 @@ def jerk(commands, command, previous, speed):
     keep_x = 2.0 * command[0] - previous[0]
     keep_y = 2.0 * command[1] - previous[1]
     keep_w = 2.0 * command[2] - previous[2]
-    return np.hypot(commands[:, 0] - keep_x, commands[:, 1] - keep_y) + speed * np.abs(
-        commands[:, 2] - keep_w
-    )
+    out = np.empty(len(commands))
+    for i in range(len(commands)):
+        linear = np.hypot(commands[i, 0] - keep_x, commands[i, 1] - keep_y)
+        out[i] = linear + speed * abs(commands[i, 2] - keep_w)
+    return out
+
+
+@numba.njit(cache=True)
+def _first_best(score):
+    """The index of the highest score, the first of equals (``np.argmax``)."""
+    best = 0
+    for i in range(1, score.size):
+        if score[i] > score[best]:
+            best = i
+    return best
 
 
 @numba.njit(cache=True)
@@ -157,15 +192,20 @@ def steady_choice(score, change, tolerance, speeds, speed, step):
     choice kept a crawl (0.14 m/s for 90 s in a 1.0 m corridor whose Eq. 7
     limit is 0.45 m/s).
     """
-    top, low = score.max(), score.min()
-    near = score >= top - tolerance * (top - low)
-    if speeds[np.argmax(score)] > speed + step:
-        faster = near & (speeds >= speed + step)
-        if faster.any():
-            near = faster
+    top, low = score[0], score[0]
+    for value in score:
+        top, low = max(top, value), min(low, value)
+    floor = top - tolerance * (top - low)
+    faster_only = False
+    if speeds[_first_best(score)] > speed + step:
+        for i in range(score.size):
+            if score[i] >= floor and speeds[i] >= speed + step:
+                faster_only = True
+                break
     best = -1
     for i in range(score.size):
-        if near[i] and (
+        near = score[i] >= floor and (not faster_only or speeds[i] >= speed + step)
+        if near and (
             best < 0
             or change[i] < change[best]
             or (change[i] == change[best] and score[i] > score[best])
@@ -192,31 +232,45 @@ def choose(
     ``speed``) after ``previous``, ``step`` the least speed-up that counts as faster.
     """
     alpha, beta, gamma, face_weight, route_weight = weights
-    sampled = commands[ok]
-    end_x, end_y, end_theta = xs[ok, -1], ys[ok, -1], thetas[ok, -1]
+    n, last = ok.size, xs.shape[1] - 1
+    sampled = np.empty((n, 3))
+    end_x, end_y, end_theta, room = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        k = ok[i]
+        sampled[i, 0], sampled[i, 1], sampled[i, 2] = commands[k, 0], commands[k, 1], commands[k, 2]
+        end_x[i], end_y[i], end_theta[i] = xs[k, last], ys[k, last], thetas[k, last]
     speeds = speeds_of(sampled)
     travel = travel_angles(sampled, speeds)
     head = xhead(travel, end_x, end_y, end_theta, target_x, target_y)
-    if reach > 0:
-        gap_x, gap_y = xs[ok] - target_x, ys[ok] - target_y
-        reached = np.empty(ok.size, dtype=np.bool_)
-        for i in range(ok.size):
-            reached[i] = (gap_x[i] * gap_x[i] + gap_y[i] * gap_y[i]).min() <= reach * reach
-        head = np.where(reached, np.pi, head)
-    if approach:  # nearness to the target in place of clearance
-        room = cap - np.minimum(np.hypot(end_x - target_x, end_y - target_y), cap)
-    else:
-        room = clearance[ok]
-    score = (
-        alpha * normalised(head)
-        + beta * normalised(np.minimum(room, cap))
-        + gamma * normalised(speeds)
-    )
+    for i in range(n):
+        if reach > 0:  # a trajectory that passes the target: full xhead
+            k, near = ok[i], np.inf
+            for step_k in range(last + 1):
+                gap_x, gap_y = xs[k, step_k] - target_x, ys[k, step_k] - target_y
+                near = min(near, gap_x * gap_x + gap_y * gap_y)
+            if near <= reach * reach:
+                head[i] = np.pi
+        if approach:  # nearness to the target in place of clearance
+            room[i] = cap - min(np.hypot(end_x[i] - target_x, end_y[i] - target_y), cap)
+        else:
+            room[i] = clearance[ok[i]]
+        room[i] = min(room[i], cap)
+    by_head, by_room, by_speed = normalised(head), normalised(room), normalised(speeds)
+    score = np.empty(n)
+    for i in range(n):
+        score[i] = alpha * by_head[i] + beta * by_room[i] + gamma * by_speed[i]
     if face_weight > 0:
-        score = score + face_weight * normalised(facing(travel))
+        by_facing = normalised(facing(travel))
+        for i in range(n):
+            score[i] = score[i] + face_weight * by_facing[i]
     if route_weight > 0:
-        score = score + route_weight * normalised(on_route(offsets[ok], cap))
+        strays = np.empty(n)
+        for i in range(n):
+            strays[i] = offsets[ok[i]]
+        by_route = normalised(on_route(strays, cap))
+        for i in range(n):
+            score[i] = score[i] + route_weight * by_route[i]
     if steady > 0 and speed >= _EPS:  # at rest: nothing to keep
         change = jerk(sampled, command, previous, speed)
         return ok[steady_choice(score, change, steady, speeds, speed, step)]
-    return ok[np.argmax(score)]
+    return ok[_first_best(score)]

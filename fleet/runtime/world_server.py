@@ -32,10 +32,11 @@ from planner.errors import EnvironmentFailure
 
 POLL_S = 0.02
 RESEND_S = 0.5  # while an AGV is lost, tick k goes out again this often
-START_TIMEOUT_S = 60.0
+START_TIMEOUT_S = 120.0
 """How long the world waits for every AGV before tick 0. A first run on a fresh install
-compiles every numba kernel in the AGV host before its AGVs come up (about 37 s on a
-2-core machine); 30 s failed it as soon as the host had more to warm up."""
+compiles every numba kernel in the AGV host before its AGVs come up: about 55 s on a
+2-core machine since the control cycle is compiled (37 s before). 30 s, then 60 s, came
+too close to that."""
 SAY_WAITING_AFTER_S = 3.0  # a wait this long for the AGVs is said (``say_waiting``)
 
 
