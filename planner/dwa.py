@@ -22,7 +22,7 @@ One control cycle (``DwaPlanner.plan``):
    |omega| <= sqrt(2 clearance alpha_max), clearance being the trajectory's
    minimum (the paper says "from the end of the trajectory"; the minimum is
    Fox et al.'s definition and the safe one).
-5. Score (Eq. 10) over the admissible samples:
+5. Score (Eq. 10) over the admissible samples (``planner.dwa_scores``, compiled):
    G = alpha xhead + beta dist + gamma vel, each term divided by its sum over
    them; xhead = pi - |heading error| at the trajectory's end towards the
    local target, the heading being the direction of travel (body heading plus
