@@ -30,20 +30,13 @@ def _block_sum(values, start, count):
         for i in range(count):
             total += values[start + i]
         return total
-    r0, r1, r2, r3 = values[start], values[start + 1], values[start + 2], values[start + 3]
-    r4, r5, r6, r7 = values[start + 4], values[start + 5], values[start + 6], values[start + 7]
+    r = values[start : start + 8].copy()  # eight running sums
     i = 8
     while i < count - count % 8:
-        j = start + i
-        r0, r1, r2, r3 = r0 + values[j], r1 + values[j + 1], r2 + values[j + 2], r3 + values[j + 3]
-        r4, r5, r6, r7 = (
-            r4 + values[j + 4],
-            r5 + values[j + 5],
-            r6 + values[j + 6],
-            r7 + values[j + 7],
-        )
+        for j in range(8):
+            r[j] += values[start + i + j]
         i += 8
-    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
     while i < count:
         total += values[start + i]
         i += 1
