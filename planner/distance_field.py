@@ -83,6 +83,12 @@ class DistanceField:
         _lookup_many(self.samples, 1.0 / self.spacing, xs.ravel(), ys.ravel(), out.reshape(-1))
         return out
 
+    def distance_at_point(self, x: float, y: float) -> float:
+        """``distance_at`` of one world point, without the arrays (a control cycle asks for
+        a few such points: numpy's broadcasting took longer than the lookup)."""
+        ox, oy = self.grid.origin
+        return lookup(self.samples, 1.0 / self.spacing, float(x) - ox, float(y) - oy)
+
 
 def _obstacle_lattice(blocked: np.ndarray, s: int) -> np.ndarray:
     """(H*s+1, W*s+1) bool: lattice points on or inside an obstacle square or the border."""

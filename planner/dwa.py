@@ -610,9 +610,9 @@ class DwaPlanner:
                     *field.origin,
                 )  # fmt: skip
                 speeds = np.hypot(commands[:, 0], commands[:, 1])
-                here = float(field.distance_at(pose[0], pose[1])) - cfg.radius
+                here = field.distance_at_point(pose[0], pose[1]) - cfg.radius
                 best = evasive_index(*times, into_wall(walls, here), speeds, cfg.max_accel, cfg.dt)
-                chosen = tuple(float(v) for v in commands[best])
+                chosen = tuple(commands[best].tolist())
                 path = (xs[best], ys[best], thetas[best])
                 return DwaResult(chosen, _poses(path), len(commands), 0)
             brake = braking_command(cfg, command)
@@ -634,7 +634,7 @@ class DwaPlanner:
             cfg.clearance_cap, steady, command, command if previous is None else previous,
             speed, step,
         )  # fmt: skip
-        chosen = tuple(float(v) for v in commands[best])
+        chosen = tuple(commands[best].tolist())
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
 
     def _braking_room(self, commands, pose, command, lane_room: float, stop_at) -> np.ndarray:
@@ -710,6 +710,7 @@ class DwaPlanner:
 
 def _poses(path) -> np.ndarray:
     """(K, 3) poses from x, y, theta rows, theta wrapped to [-pi, pi)."""
-    out = np.column_stack(path)
+    out = np.empty((len(path[0]), 3))  # np.column_stack's, without its checks
+    out[:, 0], out[:, 1], out[:, 2] = path
     out[:, 2] = wrap_angle(out[:, 2])
     return out

@@ -38,7 +38,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -154,7 +154,7 @@ class ControlStep:
 
 def _step(command, status, target=None, trajectory=None, plan=None) -> ControlStep:
     empty = np.empty((0, 3))
-    command = tuple(float(v) for v in command)
+    command = tuple(map(float, command))
     return ControlStep(
         command, status, target, empty if trajectory is None else trajectory, plan, 0.0
     )
@@ -300,7 +300,10 @@ class FusionController:
         self._recovery_started = ""
         out = self._step(pose, command, now, moving, walkers, hold)
         self._previous = command
-        return replace(out, plan_time_s=time.perf_counter() - t0, recovery=self._recovery_started)
+        return ControlStep(
+            out.command, out.status, out.target, out.trajectory, out.plan,
+            plan_time_s=time.perf_counter() - t0, recovery=self._recovery_started,
+        )  # fmt: skip
 
     def _step(self, pose, command, now, moving, walkers, hold=None) -> ControlStep:
         stop = (0.0, 0.0, 0.0)
@@ -470,7 +473,7 @@ class FusionController:
             return None
         cfg = self.config.dwa
         stopping = math.hypot(command[0], command[1]) ** 2 / (2.0 * cfg.max_accel)
-        if stopping > self.dwa.distance_field.distance_at(pose[0], pose[1]) - cfg.radius:
+        if stopping > self.dwa.distance_field.distance_at_point(pose[0], pose[1]) - cfg.radius:
             return braking_command(cfg, command)
         turn = turn_command(cfg, error, command)
         self._rounding = turn is not None

@@ -52,7 +52,7 @@ STRAIGHT_ON = math.radians(5.0)
 
 def node_room(field: DistanceField, radius: float, node: Point) -> float:
     """Eq. (7)'s room at ``node``: the body's clearance there (m, >= 0)."""
-    return max(0.0, float(field.distance_at(node[0], node[1])) - radius)
+    return max(0.0, field.distance_at_point(node[0], node[1]) - radius)
 
 
 def route_room(

@@ -41,7 +41,7 @@ def towards(config: DwaConfig, command: Command, wanted: Command) -> Command:
 def clearance_at(field: DistanceField, discs: np.ndarray | None, x: float, y: float) -> float:
     """Distance from (x, y) to the nearest obstacle: the map's, or a disc's edge (rows
     [x, y, vx, vy, r], where they stand now)."""
-    gap = float(field.distance_at(x, y))
+    gap = field.distance_at_point(x, y)
     if discs is not None and len(discs):
         gap = min(gap, float((np.hypot(discs[:, 0] - x, discs[:, 1] - y) - discs[:, 4]).min()))
     return gap
@@ -82,7 +82,7 @@ def off_walls(
 
     if not presses_wall(field, x, y, direction, radius):
         return direction
-    normal = _gradient(lambda px, py: float(field.distance_at(px, py)), x, y, field.spacing)
+    normal = _gradient(lambda px, py: field.distance_at_point(px, py), x, y, field.spacing)
     if normal is None:
         return (0.0, 0.0)
     into = direction[0] * normal[0] + direction[1] * normal[1]
@@ -99,9 +99,9 @@ def presses_wall(
 ) -> bool:
     """Whether a body of ``radius`` at (x, y) moving along the unit ``direction`` comes
     nearer a wall than it may: than touching, or than it already is where it touches."""
-    floor = min(radius, float(field.distance_at(x, y)))
+    floor = min(radius, field.distance_at_point(x, y))
     step = field.spacing
-    ahead = float(field.distance_at(x + direction[0] * step, y + direction[1] * step))
+    ahead = field.distance_at_point(x + direction[0] * step, y + direction[1] * step)
     return ahead < floor - 1e-9
 
 

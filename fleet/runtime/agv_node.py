@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bridge import keys
-from bridge.messages import AgvCommand, PlanMsg, Tick, TrajectoryMsg
+from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
 from planner.agv_status import FAILED, FINISHED
 from planner.clearance import Clearance
@@ -62,6 +62,7 @@ class AgvNode:
         self.guard = traffic_guard(scenario, self.controller)
         self._parked: frozenset[str] = frozenset()
         self._started = False
+        self._index = 0  # where this AGV's state was in the last tick's list
 
     def warm_up(self) -> None:
         """Load (or compile) every numba kernel this node uses, before the run starts.
@@ -89,12 +90,13 @@ class AgvNode:
         step_pose(pose, rest, cfg.dt)
         wrap_angle(0.0)
         dwa.distance_field.distance_at(*start)
+        dwa.distance_field.distance_at_point(*start)
         if self.guard is not None:
             self.guard.passages.first_crossing([start, goal], 1.0)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""
-        me = next((s for s in tick.agvs if s.name == self.name), None)
+        me = self._own_state(tick)
         if me is None:
             return None
         pose = (me.x, me.y, me.theta)
@@ -137,9 +139,20 @@ class AgvNode:
         trajectory = None
         if len(step.trajectory):
             trajectory = TrajectoryMsg(
-                self.name, tick.tick, np.round(step.trajectory[:, :2], 4).tolist()
+                self.name, tick.tick, step.trajectory[:, :2].round(4).tolist()
             )
         return NodeOutput(command, plan_msg, trajectory)
+
+    def _own_state(self, tick: Tick) -> AgvState | None:
+        """This AGV's state in ``tick``: at its place in the last tick, else searched."""
+        agvs = tick.agvs
+        if self._index < len(agvs) and agvs[self._index].name == self.name:
+            return agvs[self._index]
+        for index, state in enumerate(agvs):
+            if state.name == self.name:
+                self._index = index
+                return state
+        return None
 
     def _command(self, tick: Tick, command, status: str, target=None) -> AgvCommand:
         return AgvCommand(
@@ -179,11 +192,13 @@ class AgvNode:
     def _discs(self, tick: Tick) -> np.ndarray:
         """Every other AGV and moving obstacle as (x, y, vx, vy, radius), world frame; one
         array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
-        others = [s for s in tick.agvs if s.name != self.name]
-        n = len(others)
-        values = itertools.chain.from_iterable(map(_STATE_FIELDS, others))  # np.array of
+        agvs = tick.agvs
+        values = itertools.chain.from_iterable(map(_STATE_FIELDS, agvs))  # np.array of
         # the rows took half as long again: it inspects each row's shape
-        fields = np.fromiter(values, dtype=float, count=7 * n).reshape(n, 7)
+        every = np.fromiter(values, dtype=float, count=7 * len(agvs)).reshape(len(agvs), 7)
+        mine = self._index  # on_tick found this AGV's row there
+        fields = np.concatenate((every[:mine], every[mine + 1 :]))
+        n = len(fields)
         _, _, theta, vx, vy, omega, _ = fields.T
         walkers = _walkers(tick)
         discs = np.empty((n + len(walkers), 5))

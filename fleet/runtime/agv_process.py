@@ -49,6 +49,7 @@ def serve_agv(
     bus.declare_alive(keys.alive_agv(name))
     answered = 0
     last_tick, last_time, last_out = -1, 0.0, None
+    listed_before: list[str] = []  # the names of the last valid tick, in its order
     while True:
         try:
             tick = ticks.get(timeout=POLL_S).msg
@@ -60,9 +61,11 @@ def serve_agv(
         if tick.tick == last_tick and last_out is not None:
             publish_output(bus.publish, last_out)  # a re-sent tick: the same answer
             continue
-        if sorted(s.name for s in tick.agvs) != names or tick.tick < last_tick:
+        listed = [s.name for s in tick.agvs]
+        if (listed != listed_before and sorted(listed) != names) or tick.tick < last_tick:
             bus.count_invalid(keys.WORLD_TICK, f"tick {tick.tick} is not the next of this run")
             continue
+        listed_before = listed
         last_tick, last_time = tick.tick, tick.time
         try:
             last_out = node.on_tick(tick)
