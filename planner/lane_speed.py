@@ -40,7 +40,7 @@ import numpy as np
 
 from planner.distance_field import DistanceField
 from planner.grid_map import Point
-from planner.motion import world_velocity
+from planner.motion import turned_velocity
 from planner.path_metrics import turn_angle
 
 ROUTE_TOLERANCE = 0.25
@@ -102,7 +102,7 @@ def oncoming(pose, command, moving, max_accel: float, horizon_s: float) -> bool:
     if moving is None or not len(moving):
         return False
     discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
-    vx, vy = world_velocity(pose[2], command[0], command[1], 0.0, 0.0)  # as it drives on
+    vx, vy = turned_velocity(float(pose[2]), float(command[0]), float(command[1]), 0.0, 0.0)
     lead = math.hypot(vx, vy) / max_accel + horizon_s  # s: braking, then a horizon's look
     return _closing_in_time(discs, float(pose[0]), float(pose[1]), float(vx), float(vy), lead)
 

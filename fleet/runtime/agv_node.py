@@ -27,7 +27,7 @@ from planner.fusion import FusionController
 from planner.global_planner import PlanResult, warm_up
 from planner.keep_right import agv_coming
 from planner.lane_speed import oncoming
-from planner.motion import world_velocity, wrap_angle
+from planner.motion import moving_discs, wrap_angle
 from planner.no_retreat import retreating
 from planner.tight_turns import approach_command, approach_path
 from planner.traffic_guard import TrafficGuard
@@ -77,6 +77,7 @@ class AgvNode:
         self.controller.start(pose)
         dwa.plan(pose, rest, goal, segment=(start, goal))
         walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
+        moving_discs(np.array([[*start, 0.0, 0.0, 0.0, 0.0, cfg.radius]] * 2), 0, walker, cfg.dt)
         dwa.plan(pose, rest, goal, walker)
         dwa.threatened(pose, walker)
         # what a control cycle calls from Python beyond DWA (each signature is loaded
@@ -122,8 +123,9 @@ class AgvNode:
             if decision.rejoin:  # it waited off its route: plan the way in from here
                 plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), "traffic")
                 self.guard.replanned()
+        walkers = _walkers(tick)
         step = self.controller.step(
-            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick), _walkers(tick),
+            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick, walkers), walkers,
             hold=decision.hold if decision else None,
         )  # fmt: skip
         if step.plan is not None:
@@ -189,24 +191,15 @@ class AgvNode:
         if seen:
             self.controller.see(seen)
 
-    def _discs(self, tick: Tick) -> np.ndarray:
+    def _discs(self, tick: Tick, walkers: np.ndarray) -> np.ndarray:
         """Every other AGV and moving obstacle as (x, y, vx, vy, radius), world frame; one
         array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
         agvs = tick.agvs
         values = itertools.chain.from_iterable(map(_STATE_FIELDS, agvs))  # np.array of
         # the rows took half as long again: it inspects each row's shape
-        every = np.fromiter(values, dtype=float, count=7 * len(agvs)).reshape(len(agvs), 7)
-        mine = self._index  # on_tick found this AGV's row there
-        fields = np.concatenate((every[:mine], every[mine + 1 :]))
-        n = len(fields)
-        _, _, theta, vx, vy, omega, _ = fields.T
-        walkers = _walkers(tick)
-        discs = np.empty((n + len(walkers), 5))
-        discs[:n, :2] = fields[:, :2]
-        discs[:n, 2:4] = world_velocity(theta, vx, vy, omega, self.scenario.dt)
-        discs[:n, 4] = fields[:, 6]
-        discs[n:] = walkers
-        return discs
+        states = np.fromiter(values, dtype=float, count=7 * len(agvs)).reshape(len(agvs), 7)
+        # on_tick found this AGV's row at self._index
+        return moving_discs(states, self._index, walkers, self.scenario.dt)
 
     def _plan_msg(self, tick: Tick, plan: PlanResult | None, reason: str) -> PlanMsg | None:
         return None if plan is None else plan_message(self.name, tick, plan, reason)
