@@ -6,7 +6,10 @@ stops at its recursion limit), every field's type, finite numbers, list lengths,
 that a message on ``agv/<name>/...`` names that AGV (in C by ``bridge.struct_decoder``,
 else by the reference decoder here). One that fails is counted per key and logged once
 per key (to the node's stderr); the node goes on. Subscribers deliver into a queue so a
-node can wait with a timeout (``recv()`` of zenoh handlers has none).
+node can wait with a timeout (``recv()`` of zenoh handlers has none): a
+``queue.SimpleQueue``, in C: ``queue.Queue``'s Python locks cost 50 AGV processes, whose
+caches are cold at every tick, 4 to 6 ms of CPU per tick in their main threads and 2.5 ms
+in their receiving threads (of about 65 and 15).
 """
 
 from __future__ import annotations
@@ -93,10 +96,10 @@ class Bus:
             self._publishers[key] = pub
         pub.put(payload)
 
-    def subscribe(self, key_expr: str) -> queue.Queue:
+    def subscribe(self, key_expr: str) -> queue.SimpleQueue:
         """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
         (with its payload as it came, which the recorder stores)."""
-        q: queue.Queue = queue.Queue()
+        q: queue.SimpleQueue = queue.SimpleQueue()
 
         def on_sample(sample: zenoh.Sample) -> None:
             key = self.relative(sample.key_expr)
@@ -131,9 +134,9 @@ class Bus:
         replies = self.session.liveliness().get(self.full(key), timeout=timeout)
         return any(reply.ok is not None for reply in replies)
 
-    def watch_alive(self, key_expr: str) -> queue.Queue:
+    def watch_alive(self, key_expr: str) -> queue.SimpleQueue:
         """A queue of (relative key, alive: bool) for tokens on ``key_expr``, present ones first."""
-        q: queue.Queue = queue.Queue()
+        q: queue.SimpleQueue = queue.SimpleQueue()
 
         def on_sample(sample: zenoh.Sample) -> None:
             q.put((self.relative(sample.key_expr), sample.kind == zenoh.SampleKind.PUT))
