@@ -214,15 +214,25 @@ class Window:
 
 def window(config: DwaConfig, command: Command) -> Window:
     """``dynamic_window``'s samples as a ``Window``."""
-    vx, vy, omega = command
-    dv = config.max_accel * config.dt
-    vxs = window_axis(vx, config.min_vx, config.max_speed, dv, config.v_resolution)
-    vys = window_axis(vy, -config.max_speed, config.max_speed, dv, config.v_resolution)
-    omegas = window_axis(
-        omega, -config.max_omega, config.max_omega, config.max_alpha * config.dt,
-        config.omega_resolution,
+    vx, vy, omega = (float(v) for v in command)
+    dv, dw = config.max_accel * config.dt, config.max_alpha * config.dt
+    return Window(
+        *_window(
+            vx, vy, omega, config.min_vx, config.max_speed, config.max_omega, dv, dw,
+            config.v_resolution, config.omega_resolution,
+        )
     )  # fmt: skip
-    return Window(*_window_grid(vxs, vys, omegas, config.max_speed + _EPS), omegas)
+
+
+@numba.njit(cache=True)
+def _window(vx, vy, omega, min_vx, max_speed, max_omega, dv, dw, v_step, omega_step):
+    """``window``'s commands, their turn rates' indices and the turn rates, in one call (four
+    from Python cost more than the sampling)."""
+    vxs = window_axis(vx, min_vx, max_speed, dv, v_step)
+    vys = window_axis(vy, -max_speed, max_speed, dv, v_step)
+    omegas = window_axis(omega, -max_omega, max_omega, dw, omega_step)
+    commands, which = _window_grid(vxs, vys, omegas, max_speed + _EPS)
+    return commands, which, omegas
 
 
 @numba.njit(cache=True)
@@ -439,6 +449,17 @@ def _by_gap(discs, x, y, agv_reach, radius, horizon_s):
     return sorted_discs, sorted_least
 
 
+@numba.njit(cache=True)
+def _on_route(offsets, braking, clearance, tolerance):
+    """``braking`` where a sample follows the route (within ``tolerance``) and it exceeds
+    the clearance, else 0: numpy's ``where`` of the two tests, in one call."""
+    out = np.empty(len(braking))
+    for i in range(len(braking)):
+        follows = offsets[i] <= tolerance and braking[i] > clearance[i]
+        out[i] = braking[i] if follows else 0.0
+    return out
+
+
 def admissible_mask(
     config: DwaConfig,
     commands: np.ndarray,
@@ -583,7 +604,7 @@ class DwaPlanner:
             # only the samples that follow the route get the room; the others (0: the
             # discs' kernel skips them) keep Eq. (7)'s clearance, which the lane only
             # ever relaxes
-            braking = np.where((offsets <= ROUTE_TOLERANCE) & (braking > clearance), braking, 0.0)
+            braking = _on_route(offsets, braking, clearance, ROUTE_TOLERANCE)
             # the gap to moving discs bounds the room too (Eq. 7 for them)
             near = by_gap.within(float(braking.max()))
             if len(near):
