@@ -145,6 +145,8 @@ def main() -> None:
         "--evict-mb", type=int, default=default_mb, help="memory written before a cold step"
     )
     args = parser.parse_args()
+    if args.agvs < 1 or args.ticks < 2 or args.evict_mb < 1:
+        parser.error("--agvs and --evict-mb must be at least 1, --ticks at least 2")
     sim_time = (FIRST_TICK + args.ticks + 1) * 0.1
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "cold-step.toml"
@@ -157,6 +159,8 @@ def main() -> None:
     )
     AgvNode(scenario, scenario.agvs[0].name).warm_up()
     times = run(scenario, Evictor(args.evict_mb), args.ticks)
+    if not (times.steps["warm"] and times.steps["cold"]):
+        sys.exit("cold_step: every AGV stopped before the measured ticks (fewer --ticks?)")
     warm, cold = times.ms_per_step("warm"), times.ms_per_step("cold")
     print(f"  warm step  {warm:.3f} ms per AGV ({times.steps['warm']} steps)")
     print(f"  cold step  {cold:.3f} ms per AGV ({times.steps['cold']} steps)")

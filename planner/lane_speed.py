@@ -104,7 +104,7 @@ def oncoming(pose, command, moving, max_accel: float, horizon_s: float) -> bool:
     discs = np.ascontiguousarray(np.asarray(moving, dtype=float).reshape(-1, 5))
     vx, vy = turned_velocity(float(pose[2]), float(command[0]), float(command[1]), 0.0, 0.0)
     lead = math.hypot(vx, vy) / max_accel + horizon_s  # s: braking, then a horizon's look
-    return _closing_in_time(discs, float(pose[0]), float(pose[1]), float(vx), float(vy), lead)
+    return _closing_in_time(discs, float(pose[0]), float(pose[1]), vx, vy, lead)
 
 
 @numba.njit(cache=True)
