@@ -32,6 +32,7 @@ from planner.distance_field import DistanceField
 from planner.dwa import Command, DwaConfig, Pose, step_pose
 from planner.grid_map import Point
 from planner.path_metrics import turn_angle
+from planner.recovery import step_towards
 from planner.route_check import route_samples
 
 TURN_ON_SPOT = math.radians(10.0)
@@ -159,12 +160,8 @@ def _approach(limits, pose, command, node, cap):
     dv, dw = max_accel * dt, max_alpha * dt
     dx, dy = node[0] - pose[0], node[1] - pose[1]
     distance = hypot(dx, dy)
-    if distance < 1e-9:  # there: every component towards zero (``recovery.towards``)
-        return (
-            command[0] + min(max(0.0 - command[0], -dv), dv),
-            command[1] + min(max(0.0 - command[1], -dv), dv),
-            command[2] + min(max(0.0 - command[2], -dw), dw),
-        )
+    if distance < 1e-9:  # there: every component towards zero
+        return step_towards(command, (0.0, 0.0, 0.0), dv, dw)
     # the braking curve, and no faster than reaches the node in one period (no overshoot
     # and no chatter round it)
     speed = min(cap, max_speed, math.sqrt(2.0 * max_accel * distance), distance / dt)

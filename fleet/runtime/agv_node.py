@@ -29,6 +29,7 @@ from planner.keep_right import agv_coming
 from planner.lane_speed import oncoming
 from planner.motion import moving_discs, wrap_angle
 from planner.no_retreat import retreating
+from planner.recovery import towards
 from planner.tight_turns import approach_command, approach_path
 from planner.traffic_guard import TrafficGuard
 
@@ -89,6 +90,7 @@ class AgvNode:
         approach_path(cfg, pose, rest, goal, cfg.max_speed)
         approach_command(cfg, pose, rest, goal, cfg.max_speed)
         step_pose(pose, rest, cfg.dt)
+        towards(cfg, rest, rest)  # the recoveries' commands
         wrap_angle(0.0)
         dwa.distance_field.distance_at(*start)
         dwa.distance_field.distance_at_point(*start)
@@ -193,7 +195,7 @@ class AgvNode:
 
     def _discs(self, tick: Tick, walkers: np.ndarray) -> np.ndarray:
         """Every other AGV and moving obstacle as (x, y, vx, vy, radius), world frame; one
-        array operation for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
+        compiled call for all AGVs (with 100 AGVs, a call per AGV took most of a tick)."""
         agvs = tick.agvs
         values = itertools.chain.from_iterable(map(_STATE_FIELDS, agvs))  # np.array of
         # the rows took half as long again: it inspects each row's shape
