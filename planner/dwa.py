@@ -84,6 +84,7 @@ Command = tuple[float, float, float]
 
 _EPS = 1e-9
 _NO_OFFSETS = np.zeros(0)  # ``choose``'s offsets when the route term is off
+_NO_SEGMENT = ((0.0, 0.0), (0.0, 0.0))  # ``_evaluate``'s segment when there is none
 
 
 @dataclass(frozen=True)
@@ -408,27 +409,17 @@ def relevant_discs(
     cost is linear in the number of discs. The nearest come first: ``lower_by_discs``
     then finds a trajectory's clearance early and skips more of the others.
     """
-    return DiscsByGap(config, pose, agv_reach, discs).within(bound)
-
-
-class DiscsByGap:
-    """Discs sorted nearest first, with the least clearance each can reach within the
-    horizon: ``relevant_discs`` for several bounds from one sort (a control cycle asks
-    for three)."""
-
-    def __init__(self, config: DwaConfig, pose: Pose, agv_reach: float, discs: np.ndarray):
-        x, y = float(pose[0]), float(pose[1])
-        self.discs, self.least = _by_gap(discs, x, y, agv_reach, config.radius, config.horizon_s)
-
-    def within(self, bound: float) -> np.ndarray:
-        """The discs whose least clearance is below ``bound``, nearest first."""
-        return np.ascontiguousarray(self.discs[self.least < bound])
+    nearest_first, least = _by_gap(
+        discs, float(pose[0]), float(pose[1]), agv_reach, config.radius, config.horizon_s
+    )
+    return np.ascontiguousarray(nearest_first[least < bound])
 
 
 @numba.njit(cache=True)
 def _by_gap(discs, x, y, agv_reach, radius, horizon_s):
-    """``DiscsByGap``'s discs and least clearances, compiled: sorted by the gap now,
-    stably (an insertion sort: a few dozen discs, and numba compiled its mergesort slowly)."""
+    """The discs sorted by the gap now, stably (an insertion sort: a few dozen discs, and
+    numba compiled its mergesort slowly), and the least clearance each can reach within
+    the horizon (``relevant_discs``)."""
     n = len(discs)
     gap_now, least = np.empty(n), np.empty(n)
     for i in range(n):
@@ -523,6 +514,69 @@ def _largest_offsets(xs, ys, ax, ay, dx, dy):
     return out
 
 
+@numba.njit(cache=True)
+def _evaluate(
+    x, y, theta, vx, vy, omega, min_vx, max_speed, max_omega, dv, dw, v_step, omega_step,
+    dt, steps, horizon_s, radius, max_accel, max_alpha, samples, inv_spacing, ox, oy, discs,
+    lane, room, stopping, distance, behind, offsets_wanted, ax, ay, dx, dy,
+):  # fmt: skip
+    """``DwaPlanner.plan``'s samples and what it judges them by, in one compiled call:
+    the window's commands, their trajectories (3, N, K), each one's least clearance to
+    the map (``walls``) and with the moving ``discs`` (sorted nearest first, as
+    ``relevant_discs``), the route offsets (when ``offsets_wanted``; else empty), Eq. (7)'s
+    admissible mask, the discs in reach of the fastest sample the lane admits (the
+    fallback's choice between evading and braking looks at them), those that can lower
+    a clearance below the best static one, the samples' reach and that best clearance.
+
+    With a ``lane`` (``planner.lane_speed``) the linear speed of the samples that follow
+    the route segment (from (ax, ay) along (dx, dy)) is bounded by their room to brake
+    along it before the moving discs instead of by their clearance: the path's length
+    over the horizon, the route's ``room`` and, when ``stopping`` ``distance`` away,
+    the room before what stands ``behind`` that place. The others keep Eq. (7)'s
+    clearance, which the lane only ever relaxes.
+
+    The dozen kernels and numpy calls this was, called one by one from Python, cost an
+    AGV process (whose caches are cold at every tick with 50 of them on 2 cores) more
+    than their arithmetic. The same operations in the same order: the same values.
+    """
+    commands, which, omegas = _window(
+        vx, vy, omega, min_vx, max_speed, max_omega, dv, dw, v_step, omega_step
+    )
+    paths = _rollout(x, y, theta, commands, omegas, which, dt, steps)
+    xs, ys = paths[0], paths[1]
+    walls = static_clearance(xs, ys, samples, inv_spacing, radius, ox, oy)
+    static_best = walls.max()
+    bound = static_best
+    braking = np.empty(0)
+    if lane:
+        speed = np.hypot(commands[:, 0], commands[:, 1])
+        braking = np.minimum(speed * horizon_s, room)
+        if stopping:
+            braking = np.minimum(braking, stop_room(distance, behind, speed, horizon_s))
+        bound = max(static_best, braking.max())
+    span = math.sqrt(_largest_square_distance(xs, ys, x, y))
+    by_gap, least = _by_gap(discs, x, y, span, radius, horizon_s)
+    reached = by_gap[least < bound]
+    lowering = by_gap[least < static_best]
+    clearance = walls
+    if len(lowering):
+        clearance = lower_by_discs(xs, ys, walls, lowering, dt, radius)
+    offsets = np.empty(0)
+    if offsets_wanted:
+        offsets = _largest_offsets(xs, ys, ax, ay, dx, dy)
+    linear = clearance
+    if lane:
+        # only the samples that follow the route get the room (0: the discs' kernel
+        # skips the others); the gap to moving discs bounds it too (Eq. 7 for them)
+        braking = _on_route(offsets, braking, clearance, ROUTE_TOLERANCE)
+        near = by_gap[least < braking.max()]
+        if len(near):
+            braking = lower_by_discs(xs, ys, braking, near, dt, radius)
+        linear = np.maximum(braking, clearance)
+    mask = _admissible(commands, clearance, linear, max_accel, max_alpha)
+    return commands, paths, walls, clearance, offsets, mask, reached, lowering, span, static_best
+
+
 class DwaPlanner:
     """DWA over a static DistanceField (assignable: temporary obstacles become known)."""
 
@@ -575,42 +629,35 @@ class DwaPlanner:
         field = self.distance_field
         discs = np.zeros((0, 5)) if moving is None else np.asarray(moving, dtype=float)
         discs = np.ascontiguousarray(discs.reshape(-1, 5))
-        samples = window(cfg, command)
-        commands = samples.commands
-        xs, ys, thetas = rollout(pose, commands, cfg.dt, cfg.steps, samples)
-        clearance = static_clearance(
-            xs, ys, field.samples, 1.0 / field.spacing, cfg.radius, *field.origin
-        )
-        static_best = float(clearance.max())
-        walls = clearance  # each sample's least clearance to the map (the discs lower a copy)
-        braking = None
-        if lane_room is not None and segment is not None:
-            stop_at = target_xy if stop else None
-            braking = self._braking_room(commands, pose, command, lane_room, stop_at)
-        # the discs in reach of the fastest sample the lane admits (the fallback's choice
-        # between evading and braking looks at them), of which those that can lower a
-        # clearance below the best static one
-        bound = static_best if braking is None else max(static_best, float(braking.max()))
-        span = sample_reach(pose, xs, ys)
-        by_gap = DiscsByGap(cfg, pose, span, discs)
-        discs = by_gap.within(bound)
-        lowering = by_gap.within(static_best)
-        if len(lowering):
-            clearance = lower_by_discs(xs, ys, clearance, lowering, cfg.dt, cfg.radius)
-        offsets = None  # how far each sample strays from the route: the lane and the score
-        if segment is not None and (braking is not None or self.behaviour.route_weight > 0):
-            offsets = route_offsets(xs, ys, segment)
-        if braking is not None:
-            # only the samples that follow the route get the room; the others (0: the
-            # discs' kernel skips them) keep Eq. (7)'s clearance, which the lane only
-            # ever relaxes
-            braking = _on_route(offsets, braking, clearance, ROUTE_TOLERANCE)
-            # the gap to moving discs bounds the room too (Eq. 7 for them)
-            near = by_gap.within(float(braking.max()))
-            if len(near):
-                braking = lower_by_discs(xs, ys, braking, near, cfg.dt, cfg.radius)
-            braking = np.maximum(braking, clearance)
-        mask = admissible_mask(cfg, commands, clearance, braking)
+        lane = lane_room is not None and segment is not None
+        # how far each sample strays from the route: the lane and the score
+        offsets_wanted = segment is not None and (lane or self.behaviour.route_weight > 0)
+        room, stopping, distance, behind = 0.0, False, 0.0, 0.0
+        if lane:
+            # never less than the hardest braking from the current command needs: a replan
+            # that turns the route close ahead of a fast AGV leaves it braking along the
+            # route, not with nothing admissible and the fallback's choice
+            hardest = braking_room(math.hypot(command[0], command[1]), cfg.max_accel, cfg.dt)
+            room = float(max(lane_room, hardest))
+            if stop:  # the room before what stands behind the place it stops at
+                stopping = True
+                behind = node_room(field, cfg.radius, target_xy)
+                distance = math.dist(pose[:2], target_xy)
+        (ax, ay), (bx, by) = _NO_SEGMENT if segment is None else segment
+        vx, vy, omega = (float(v) for v in command)
+        evaluated = _evaluate(
+            float(pose[0]), float(pose[1]), float(pose[2]), vx, vy, omega,
+            cfg.min_vx, cfg.max_speed, cfg.max_omega, cfg.max_accel * cfg.dt,
+            cfg.max_alpha * cfg.dt, cfg.v_resolution, cfg.omega_resolution, cfg.dt, cfg.steps,
+            cfg.horizon_s, cfg.radius, cfg.max_accel, cfg.max_alpha,
+            field.samples, 1.0 / field.spacing, *field.origin, discs,
+            lane, room, stopping, distance, behind,
+            offsets_wanted, float(ax), float(ay), float(bx - ax), float(by - ay),
+        )  # fmt: skip
+        commands, paths, walls, clearance, offsets, mask, discs, lowering = evaluated[:8]
+        span, static_best = evaluated[8:]
+        xs, ys, thetas = paths
+        offsets = offsets if offsets_wanted else None
         if self.behaviour.no_retreat and len(agvs_of(lowering, walkers)):
             ahead = ahead_on_route(pose, target_xy, segment)
             mask &= ~retreating(pose, xs[:, -1], ys[:, -1], ahead)
@@ -657,23 +704,6 @@ class DwaPlanner:
         )  # fmt: skip
         chosen = tuple(commands[best].tolist())
         return DwaResult(chosen, _poses((xs[best], ys[best], thetas[best])), len(commands), len(ok))
-
-    def _braking_room(self, commands, pose, command, lane_room: float, stop_at) -> np.ndarray:
-        """(N,) each sample's room to brake along the route (``planner.lane_speed``) before
-        the moving discs: its horizon path's length, the route's ``lane_room`` (never less
-        than the hardest braking from the current ``command`` needs: a replan that turns
-        the route close ahead of a fast AGV leaves it braking along the route, not with
-        nothing admissible and the fallback's choice) and, when the AGV stops at
-        ``stop_at``, the room before what stands behind that place."""
-        cfg = self.config
-        speed = np.hypot(commands[:, 0], commands[:, 1])
-        hardest = braking_room(math.hypot(command[0], command[1]), cfg.max_accel, cfg.dt)
-        room = np.minimum(speed * cfg.horizon_s, max(lane_room, hardest))
-        if stop_at is not None:
-            behind = node_room(self.distance_field, cfg.radius, stop_at)
-            distance = math.dist(pose[:2], stop_at)
-            room = np.minimum(room, stop_room(distance, behind, speed, cfg.horizon_s))
-        return np.ascontiguousarray(room)
 
     def _clear_of_walkers_later(self, mask, command, ends, discs, route, came_by) -> np.ndarray:
         """``mask`` narrowed to the samples whose end point no disc reaches before the

@@ -119,6 +119,7 @@ def _closing_in_time(discs, x, y, vx, vy, lead):
     return False
 
 
+@numba.njit(cache=True)
 def stop_room(distance: float, behind: float, speed: np.ndarray, horizon_s: float) -> np.ndarray:
     """(N,) the room to brake before a place the AGV stops at, ``distance`` away with
     ``behind`` of clearance round it: the constant-velocity horizon of a sample at

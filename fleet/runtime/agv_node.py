@@ -81,6 +81,7 @@ class AgvNode:
         moving_discs(np.array([[*start, 0.0, 0.0, 0.0, 0.0, cfg.radius]] * 2), 0, walker, cfg.dt)
         dwa.plan(pose, rest, goal, walker)
         dwa.threatened(pose, walker)
+        dwa.clearance_along(np.array([pose]), walker)  # its map and disc kernels, from Python
         # what a control cycle calls from Python beyond DWA (each signature is loaded
         # once per process: in each of 50 forked AGV processes it cost the first ticks)
         coming = np.array([[*goal, -0.5, 0.0, cfg.radius]])  # an AGV head-on
