@@ -55,6 +55,7 @@ sqrt(2 a_max d), while always keeping the hardest deceleration the window has.
 
 from __future__ import annotations
 
+import functools
 import math
 import numbers
 from collections.abc import Sequence
@@ -131,12 +132,12 @@ class DwaConfig:
                 f"DWA predict_time ({self.predict_time} s) must be at least dt ({self.dt} s)"
             )
 
-    @property
+    @functools.cached_property  # asked several times in every control cycle
     def steps(self) -> int:
         """Rollout steps over the horizon."""
         return max(1, round(self.predict_time / self.dt))
 
-    @property
+    @functools.cached_property
     def horizon_s(self) -> float:
         """s: the rollout's length in time (``steps`` periods)."""
         return self.steps * self.dt

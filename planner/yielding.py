@@ -179,6 +179,8 @@ def walker_coming(pose, walkers) -> bool:
     A standing walker counts as coming: it may start towards the AGV at any time.
     """
     near = _walkers_in_range(pose, walkers)
+    if not len(near):  # every control cycle asks, mostly with no walker about
+        return False
     away = (near[:, 0] - pose[0]) * near[:, 2] + (near[:, 1] - pose[1]) * near[:, 3] > 0.0
     return bool((~away).any())
 

@@ -221,11 +221,16 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
     return TrafficGuard(Costmap.for_grid(scenario.grid, widest), controller.config.dwa)
 
 
+# shared by every tick without moving obstacles (left writeable, which it never is
+# written: numba compiles a read-only array's kernels again, mid-run)
+_NO_WALKERS = np.zeros((0, 5))
 _STATE_FIELDS = operator.attrgetter("x", "y", "theta", "vx", "vy", "omega", "radius")
 
 
 def _walkers(tick: Tick) -> np.ndarray:
     """The moving obstacles as (x, y, vx, vy, radius) rows: discs that do not avoid an AGV."""
+    if not tick.moving:
+        return _NO_WALKERS
     moving = [(o.x, o.y, o.vx, o.vy, o.radius) for o in tick.moving]
     return np.array(moving, dtype=float).reshape(-1, 5)
 
