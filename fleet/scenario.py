@@ -7,6 +7,7 @@ message names the key or the AGV.
 
 from __future__ import annotations
 
+import functools
 import math
 import tomllib
 from dataclasses import dataclass, replace
@@ -109,10 +110,15 @@ class Scenario:
     path: str
 
     def agv(self, name: str) -> AgvSpec:
-        for a in self.agvs:
-            if a.name == name:
-                return a
-        raise ScenarioError(f"no AGV named {name!r} in scenario {self.name!r}")
+        spec = self._agvs_by_name.get(name)
+        if spec is None:
+            raise ScenarioError(f"no AGV named {name!r} in scenario {self.name!r}")
+        return spec
+
+    @functools.cached_property
+    def _agvs_by_name(self) -> dict[str, AgvSpec]:
+        # the world looks up every AGV's spec at every tick: a search of 50 was 1250 steps
+        return {a.name: a for a in self.agvs}
 
 
 def resolve_scenario(name_or_path: str) -> Path:

@@ -166,3 +166,10 @@ def test_cli_reports_a_broken_scenario_in_one_line(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0, proc.stderr
     assert "inside an obstacle" in proc.stderr and "Traceback" not in proc.stderr
+
+
+def test_an_agv_is_found_by_name_and_an_unknown_name_is_refused():
+    scenario = load_scenario("warehouse")
+    assert [scenario.agv(a.name) for a in scenario.agvs] == list(scenario.agvs)
+    with pytest.raises(ScenarioError, match="no AGV named 'nobody'"):
+        scenario.agv("nobody")
