@@ -271,16 +271,12 @@ def braking_command(config: DwaConfig, command: Command) -> Command:
     )
 
 
-def rollout(
-    pose: Pose, commands: np.ndarray, dt: float, steps: int, samples: Window | None = None
-) -> np.ndarray:
+def rollout(pose: Pose, commands: np.ndarray, dt: float, steps: int) -> np.ndarray:
     """(3, N, K): x, y and theta after steps 1..K of each command held constant (Eq. 4).
-    ``samples``: ``commands`` as a ``Window`` (its turn rates need no search)."""
+    (A control cycle rolls out the window's samples with their turn rates as ``window``
+    found them, in ``_evaluate``: no search.)"""
     x0, y0, theta0 = pose
-    if samples is None:
-        omegas, which = np.unique(commands[:, 2], return_inverse=True)
-    else:
-        omegas, which = samples.omegas, samples.which
+    omegas, which = np.unique(commands[:, 2], return_inverse=True)
     return _rollout(float(x0), float(y0), float(theta0), commands, omegas, which, dt, steps)
 
 

@@ -11,6 +11,7 @@ from planner.distance_field import DistanceField
 from planner.dwa import (
     DwaConfig,
     DwaPlanner,
+    _rollout,
     admissible_mask,
     braking_command,
     dynamic_window,
@@ -138,8 +139,9 @@ def test_the_windows_turn_rates_roll_out_as_a_search_for_them_would(command):
     np.testing.assert_array_equal(samples.omegas, omegas)
     np.testing.assert_array_equal(samples.which, which)
     pose = (3.0, 4.0, 0.7)
-    np.testing.assert_array_equal(
-        rollout(pose, samples.commands, CFG.dt, CFG.steps, samples),
+    x, y, theta = pose
+    np.testing.assert_array_equal(  # how a control cycle rolls them out (``_evaluate``)
+        _rollout(x, y, theta, samples.commands, samples.omegas, samples.which, CFG.dt, CFG.steps),
         rollout(pose, samples.commands, CFG.dt, CFG.steps),
     )
 

@@ -221,8 +221,8 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
     return TrafficGuard(Costmap.for_grid(scenario.grid, widest), controller.config.dwa)
 
 
-# shared by every tick without moving obstacles (left writeable, which it never is
-# written: numba compiles a read-only array's kernels again, mid-run)
+# shared by every tick without moving obstacles (writeable, though nothing writes it: for a
+# read-only array numba would compile the kernels it is passed to again, mid-run)
 _NO_WALKERS = np.zeros((0, 5))
 _STATE_FIELDS = operator.attrgetter("x", "y", "theta", "vx", "vy", "omega", "radius")
 
