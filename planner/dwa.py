@@ -629,7 +629,8 @@ class DwaPlanner:
         lane = lane_room is not None and segment is not None
         # how far each sample strays from the route: the lane and the score
         offsets_wanted = segment is not None and (lane or self.behaviour.route_weight > 0)
-        room, stopping, distance, behind = 0.0, False, 0.0, 0.0
+        room, behind = 0.0, 0.0
+        distance = math.dist(pose[:2], target_xy) if stop else 0.0  # to where it stops
         if lane:
             # never less than the hardest braking from the current command needs: a replan
             # that turns the route close ahead of a fast AGV leaves it braking along the
@@ -637,9 +638,7 @@ class DwaPlanner:
             hardest = braking_room(math.hypot(command[0], command[1]), cfg.max_accel, cfg.dt)
             room = float(max(lane_room, hardest))
             if stop:  # the room before what stands behind the place it stops at
-                stopping = True
                 behind = node_room(field, cfg.radius, target_xy)
-                distance = math.dist(pose[:2], target_xy)
         (ax, ay), (bx, by) = _NO_SEGMENT if segment is None else segment
         vx, vy, omega = (float(v) for v in command)
         evaluated = _evaluate(
@@ -648,7 +647,7 @@ class DwaPlanner:
             cfg.max_alpha * cfg.dt, cfg.v_resolution, cfg.omega_resolution, cfg.dt, cfg.steps,
             cfg.horizon_s, cfg.radius, cfg.max_accel, cfg.max_alpha,
             field.samples, 1.0 / field.spacing, *field.origin, discs,
-            lane, room, stopping, distance, behind,
+            lane, room, lane and stop, distance, behind,
             offsets_wanted, float(ax), float(ay), float(bx - ax), float(by - ay),
         )  # fmt: skip
         commands, paths, walls, clearance, offsets, mask, discs, lowering = evaluated[:8]
@@ -664,8 +663,7 @@ class DwaPlanner:
             mask = self._clear_of_walkers_later(mask, command, ends, walkers, route, came_by)
         if stop:
             speed = np.hypot(commands[:, 0], commands[:, 1])
-            room = math.dist(pose[:2], target_xy)
-            limit = max(math.sqrt(2.0 * cfg.max_accel * room), float(speed.min()))
+            limit = max(math.sqrt(2.0 * cfg.max_accel * distance), float(speed.min()))
             mask &= speed <= limit + _EPS
         ok = np.flatnonzero(mask)
         if ok.size == 0:
