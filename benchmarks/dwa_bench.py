@@ -3,7 +3,7 @@
 The set-up: a 50 x 50 map (1 m cells, ~20 % random obstacles,
 numpy default_rng(0)), the paper's sampling (Table 1: 5 x 5 x 11 = 275
 samples per cycle), 10 moving discs around the AGV, 200 random situations
-(pose, current command, local target, discs). ``planner.dwa.DwaPlanner`` is
+(pose, current command, local target, discs). ``planner.local.dwa.DwaPlanner`` is
 timed over 2000 cycles after a warm-up; the reference, written here in the
 PythonRobotics style (Python loops over samples and horizon steps, Eq. (4)
 stepped one period at a time, the same window, clearance, admissibility and
@@ -20,9 +20,10 @@ import time
 
 import numpy as np
 
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner
-from planner.grid_map import GridMap
+from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
 
 MAP_SIZE = 50
 OBSTACLE_RATIO = 0.2

@@ -26,8 +26,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks.nav_episodes import make_episode
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process
-from planner.distance_field import DistanceField
-from planner.motion import world_velocity
+from planner.core.motion import world_velocity
+from planner.maps.distance_field import DistanceField
 
 STEP = 0.1  # s
 

@@ -33,11 +33,11 @@ import numpy as np
 
 from fleet.moving_obstacle import MovingObstacle
 from fleet.scenario import VEHICLE_KEYS, AgvSpec, Scenario, TemporaryObstacle
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig
-from planner.fusion import FusionConfig
-from planner.grid_map import GridMap
-from planner.random_map import random_map
+from planner.local.config import DwaConfig
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
+from planner.maps.random_map import random_map
+from planner.nav.fusion import FusionConfig
 
 SIZE = 20
 RADIUS = 0.3

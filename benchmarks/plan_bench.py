@@ -1,4 +1,4 @@
-"""Benchmark of the grid A* of ``planner.astar`` against a heapq A* and C/C++ peers.
+"""Benchmark of the grid A* of ``planner.route.astar`` against a heapq A* and C/C++ peers.
 
 Run from the repository root: ``python benchmarks/plan_bench.py [--runs N]``.
 
@@ -54,12 +54,12 @@ from pathlib import Path
 
 import numpy as np
 
-from planner.astar import search, search_costmap
-from planner.clearance import Clearance
-from planner.costmap import Costmap
-from planner.global_planner import plan_global
-from planner.grid_map import GridMap
-from planner.map_io import load_map
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
+from planner.route.astar import search, search_costmap
+from planner.route.global_planner import plan_global
 
 try:
     import tcod.path as tcod_path
@@ -70,7 +70,7 @@ try:
 except ImportError:  # optional peer
     cstar_pf = None
 
-Cell = tuple[int, int]  # (col, row), row 0 at the bottom, as in planner.grid_map
+Cell = tuple[int, int]  # (col, row), row 0 at the bottom, as in planner.maps.grid
 SQRT2 = math.sqrt(2.0)
 SIZE = 1000
 START: Cell = (0, 0)
@@ -572,12 +572,12 @@ FIRST_CALL_CODE = """
 import json, time
 import numpy as np
 t0 = time.perf_counter()
-from planner.astar import search, search_costmap
-from planner.clearance import Clearance
-from planner.costmap import Costmap
-from planner.global_planner import plan_global
-from planner.grid_map import GridMap
-from planner.map_io import load_map
+from planner.route.astar import search, search_costmap
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.route.global_planner import plan_global
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
 t1 = time.perf_counter()
 search(GridMap(np.zeros((8, 8), bool)), (0, 0), (7, 7))
 t2 = time.perf_counter()
@@ -603,7 +603,9 @@ def fresh_process(cache_dir: str | None) -> tuple[float, float] | str:
 
 
 def first_calls() -> None:
-    print("\nFirst call of planner.astar.search (one 8x8 search; numba compile or cache load)")
+    print(
+        "\nFirst call of planner.route.astar.search (one 8x8 search; numba compile or cache load)"
+    )
     t0 = time.perf_counter()
     search(GridMap(np.zeros((8, 8), bool)), (0, 0), (7, 7))
     here = time.perf_counter() - t0
@@ -620,7 +622,7 @@ def first_calls() -> None:
             imp, first = res
             print(
                 f"  fresh process, {label:29s} first search {first:6.3f} s"
-                f"   (import planner.astar incl. numba: {imp:.3f} s)  [{what}]"
+                f"   (import planner.route.astar incl. numba: {imp:.3f} s)  [{what}]"
             )
 
 
@@ -858,7 +860,7 @@ def main() -> None:
             print(f"  {line}")
         return
 
-    print("plan_bench: planner.astar vs a heapq A* and C/C++ peers")
+    print("plan_bench: planner.route.astar vs a heapq A* and C/C++ peers")
     print(
         f"  Python {platform.python_version()}, numpy {np.__version__}, numba {version('numba')}, "
         f"tcod {version('tcod') if tcod_path else 'not installed'}, "

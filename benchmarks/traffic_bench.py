@@ -209,8 +209,9 @@ def print_table(rows: list[dict]) -> None:
         "passage by the traffic rule (status 'waiting'); drive max: the most an AGV drove over\n"
         f"the length of its first route (loops and detours show here); >{DETOUR:g}x: AGVs that\n"
         "drove more than that; loops: times the AGVs' driven paths crossed themselves\n"
-        "(planner.path_metrics.self_crossings); recov: recovery behaviours the AGVs started after\n"
-        "no progress (planner.recovery); solo fail: AGVs that do not arrive alone."
+        "(planner.core.path_metrics.self_crossings); recov: recovery behaviours the AGVs\n"
+        "started after no progress (planner.nav.recovery); solo fail: AGVs that do not arrive\n"
+        "alone."
     )
 
 

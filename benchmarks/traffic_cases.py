@@ -53,10 +53,10 @@ from functools import cache
 import numpy as np
 
 from fleet.scenario import Scenario, parse_scenario
-from planner.clearance import Clearance
-from planner.costmap import point_clearance
-from planner.global_planner import plan_global
-from planner.grid_map import GridMap
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import point_clearance
+from planner.maps.grid import GridMap
+from planner.route.global_planner import plan_global
 
 CELL = 0.5  # m: the cell of the family names (corridor-2 is 2 cells = 1.0 m wide)
 RES = 0.25  # m per map cell: CELL / 2, so that the planner finds a way through 1.0 m

@@ -16,9 +16,9 @@ from dataclasses import dataclass, field
 
 import msgspec
 
-from planner.agv_status import RECOVERY_KINDS, STATUSES
-from planner.errors import BadInputError
-from planner.traffic import PHASES, Intent
+from planner.core.errors import BadInputError
+from planner.core.status import RECOVERY_KINDS, STATUSES
+from planner.traffic.zones import PHASES, Intent
 
 # No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
 # a decoded message is bounded however it was made.
@@ -110,7 +110,7 @@ class Tick:
     ``final`` marks the last tick of a run: the end state, which nobody answers.
     ``intents`` are the traffic intents that claim a passage, as the AGVs sent them with
     their commands for this tick: every AGV decides on the same ones
-    (``planner.traffic``).
+    (``planner.traffic.zones``).
     """
 
     tick: int

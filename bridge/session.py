@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import zenoh
 
-from planner.errors import EnvironmentFailure
+from planner.core.errors import EnvironmentFailure
 
 LEASE_MS = 1000
 # far above the largest message of a run (the map of a MAX_MAP_CELLS map, ~MAX_MAP_CELLS

@@ -27,9 +27,8 @@ import secrets
 from pathlib import Path
 
 from bridge.session import Guard, Login
-from planner.errors import BadInputError
-from planner.grid_map import MapError
-from planner.limits import read_input_file
+from planner.core.errors import BadInputError, MapError
+from planner.core.limits import read_input_file
 
 CREDENTIALS_ENV = "AGV_FLEET_CREDENTIALS"
 RECORDER_USER = "recorder"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from planner.errors import AgvFleetError, BadInputError, EnvironmentFailure
+from planner.core.errors import AgvFleetError, BadInputError, EnvironmentFailure
 
 OK = 0
 NOT_SUCCEEDED = 1  # the run did not succeed (an AGV did not arrive, a collision), or no path

@@ -26,15 +26,18 @@ from fleet.toml_schema import (
     get_str,
     get_table,
 )
-from planner.clearance import ClearanceError, clearance_for
-from planner.costmap import point_clearance
-from planner.dwa import DwaConfig
-from planner.fusion import VARIANTS, FusionConfig
-from planner.grid_map import GridMap, MapError
-from planner.limits import read_input_file
-from planner.map_io import UNKNOWN_CHOICES, load_map, parse_text_grid
-from planner.profiles import DEFAULT, PROFILES
-from planner.random_map import random_map
+from planner.core.errors import MapError
+from planner.core.limits import read_input_file
+from planner.core.profiles import DEFAULT, PROFILES
+from planner.local.config import DwaConfig
+from planner.maps.clearance import ClearanceError, clearance_for
+from planner.maps.costmap import point_clearance
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
+from planner.maps.random_map import random_map
+from planner.maps.ros_map import UNKNOWN_CHOICES
+from planner.maps.text_maps import parse_text_grid
+from planner.nav.fusion import VARIANTS, FusionConfig
 
 TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
@@ -58,7 +61,7 @@ PLANNER_KEYS = {
 FUSION_KEYS = (
     "safety_distance", "switch_distance", "goal_tolerance", "progress_window", "progress_distance",
 )  # fmt: skip
-# [planner] margin (m): safety_distance = radius + margin (planner.clearance); one of the two
+# [planner] margin (m): safety_distance = radius + margin (planner.maps.clearance); one of the two
 CLEARANCE_KEYS = ("margin",)
 # [agv_defaults] and per-AGV keys: TOML key (user units) -> (DwaConfig field, scale)
 VEHICLE_KEYS = {
@@ -229,7 +232,7 @@ def _parse_config(
 ) -> FusionConfig:
     """A FusionConfig from a [planner] table and vehicle keys (user units).
 
-    The safety distance comes from planner.clearance: ``safety_distance`` or ``margin``
+    The safety distance comes from planner.maps.clearance: ``safety_distance`` or ``margin``
     (not both), else radius + the default margin; below the radius it is an error."""
     dwa_args: dict = {"dt": dt}
     fusion_args: dict = {"profile": profile}

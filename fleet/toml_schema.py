@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
-from planner.errors import BadInputError
+from planner.core.errors import BadInputError
 
 
 class ScenarioError(BadInputError, ValueError):

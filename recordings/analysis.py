@@ -6,9 +6,9 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
   first tick an AGV reports ``arrived``.
 - distance travelled: the sum of |Δposition| over every tick of the run; loops,
   how often the driven path crossed itself over the drive
-  (``planner.path_metrics.self_crossings``).
+  (``planner.core.path_metrics.self_crossings``).
 - path: the first plan that found a path; its key nodes measured with
-  ``planner.path_metrics`` (length, turning times, total turning angle);
+  ``planner.core.path_metrics`` (length, turning times, total turning angle);
   replans: plans made for the reason ``replan``.
 - smoothness, over the drive (tick 0 up to the tick the AGV arrived or failed;
   parked time would dilute it): the world-frame velocity vector of each
@@ -36,12 +36,12 @@ from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from planner import path_metrics
-from planner.agv_status import FINISHED, RECOVERY, WAITING
-from planner.distance_field import DistanceField
-from planner.fusion import GLOBAL_ALGORITHM
-from planner.motion import world_velocity
-from planner.traffic import DECISIONS, WAIT
+from planner.core import path_metrics
+from planner.core.motion import world_velocity
+from planner.core.status import FINISHED, RECOVERY, WAITING
+from planner.maps.distance_field import DistanceField
+from planner.nav.fusion import GLOBAL_ALGORITHM
+from planner.traffic.zones import DECISIONS, WAIT
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
 

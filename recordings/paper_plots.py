@@ -13,8 +13,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from planner.grid_map import GridMap
-from planner.motion import world_velocity
+from planner.core.motion import world_velocity
+from planner.maps.grid import GridMap
 from recordings.plan_metrics import MapPlans
 from recordings.series import RunSeries
 

@@ -3,7 +3,7 @@
 A plan recording (``agv-fleet paper`` writes one per map) holds the map on
 ``world/map`` and one ``PlanMsg`` per algorithm on ``agv/<algorithm>/plan``.
 The metrics are recomputed here from the recorded key nodes with
-``planner.path_metrics`` (length, turning times, total turning angle), not
+``planner.core.path_metrics`` (length, turning times, total turning angle), not
 taken from the numbers the planner put in the message.
 """
 
@@ -12,8 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from bridge.keys import WORLD_MAP, agv_plan
-from planner import path_metrics
-from planner.grid_map import GridMap
+from planner.core import path_metrics
+from planner.maps.grid import GridMap
 from recordings.reader import Recording
 from recordings.series import map_grid
 

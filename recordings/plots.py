@@ -12,8 +12,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 from matplotlib.patheffects import withStroke
 
-from planner.motion import world_velocity
-from planner.path_metrics import crossing_points
+from planner.core.motion import world_velocity
+from planner.core.path_metrics import crossing_points
 from recordings.series import RunSeries
 
 DPI = 100

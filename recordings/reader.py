@@ -41,9 +41,8 @@ from mcap.writer import MCAP0_MAGIC
 from bridge.keys import WORLD_TICK, agv_name, message_type
 from bridge.messages import MessageError, from_dict
 from bridge.struct_decoder import decode_valid
-from planner.errors import BadInputError
-from planner.grid_map import MapError
-from planner.limits import open_regular_file
+from planner.core.errors import BadInputError, MapError
+from planner.core.limits import open_regular_file
 
 # what mcap raises on a cut or damaged file: its own errors, short reads in struct,
 # CRC mismatches (ValueError), unknown ids (KeyError) and bad compressed data

@@ -45,11 +45,11 @@ import rerun as rr
 
 from bridge import keys
 from bridge.messages import MessageError
-from planner.agv_status import FINISHED, RECOVERY
-from planner.clearance import Clearance
-from planner.costmap import Costmap
-from planner.passages import NONE, Passages
-from planner.traffic import HELD
+from planner.core.status import FINISHED, RECOVERY
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.traffic.passages import NONE, Passages
+from planner.traffic.zones import HELD
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
 from recordings.palette import agv_color
@@ -325,7 +325,7 @@ class RowMaker:
 
 
 def _passages(map_msg: dict, radius: float) -> Row:
-    """The passages of the map (``planner.passages``) as a translucent image over it."""
+    """The passages of the map (``planner.traffic.passages``) as a translucent image over it."""
     grid = map_grid(map_msg)
     passages = Passages.build(Costmap.build(grid, Clearance(radius)))
     inside = passages.label[::-1] != NONE  # image rows top down

@@ -23,7 +23,7 @@ from urllib.parse import quote
 
 import rerun_cli
 
-from planner.errors import EnvironmentFailure
+from planner.core.errors import EnvironmentFailure
 
 RERUN_BINARY = Path(rerun_cli.__file__).with_name("rerun")
 START_TIMEOUT = 20.0

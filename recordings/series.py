@@ -18,8 +18,8 @@ from operator import itemgetter
 import numpy as np
 
 from bridge import keys
-from planner.errors import BadInputError
-from planner.grid_map import GridMap
+from planner.core.errors import BadInputError
+from planner.maps.grid import GridMap
 from recordings.map_frame import map_origin
 from recordings.reader import Recording, paused_gc
 

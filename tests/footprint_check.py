@@ -2,7 +2,7 @@
 
 Nothing here imports the planner: distances are computed in world coordinates with
 plain numpy from the map's obstacle cells (closed squares) and its border, so that a
-bug in planner.costmap, planner.key_nodes or planner.astar cannot hide itself.
+bug in planner.maps.costmap, planner.route.key_nodes or planner.route.astar cannot hide itself.
 
 - ``route_clearance``: the exact least distance from a polyline to every obstacle
   square and to the map's border (a segment and a box that do not meet are closest at

@@ -1,6 +1,6 @@
 """An independent check that a polyline keeps to free cells.
 
-Written apart from planner.key_nodes (separating-axis test rather than
+Written apart from planner.route.key_nodes (separating-axis test rather than
 Liang–Barsky) so that a bug there cannot hide itself in the tests.
 """
 

@@ -14,9 +14,8 @@ from bridge import keys
 from bridge.messages import AgvState, Event, MapMsg, ObstacleState, PlanMsg, Tick
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
-from planner.dwa import step_pose
-from planner.motion import world_velocity
-from planner.path_metrics import crossing_points
+from planner.core.motion import step_pose, world_velocity
+from planner.core.path_metrics import crossing_points
 from recordings.analysis import analyze, compare
 from recordings.plots import map_figure, save_plots
 from recordings.reader import open_recording

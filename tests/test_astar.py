@@ -5,10 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planner.astar import search
-from planner.grid_map import GridMap
-from planner.map_io import load_movingai, load_movingai_scenarios, parse_text_grid
-from planner.path_metrics import path_length
+from planner.core.path_metrics import path_length
+from planner.maps.grid import GridMap
+from planner.maps.movingai import load_movingai, load_movingai_scenarios
+from planner.maps.text_maps import parse_text_grid
+from planner.route.astar import search
 
 SCENARIO_FILES = ("random-32-32-20-random-1.scen", "arena.map.scen")
 

@@ -18,7 +18,7 @@ from fleet.builtin import builtin_scenarios
 from fleet.cli.main import main
 from fleet.paper.experiments import record_plans
 from fleet.scenario import load_scenario
-from planner.grid_map import GridMap
+from planner.maps.grid import GridMap
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 

@@ -17,12 +17,14 @@ import numpy as np
 import pytest
 
 from fleet.paper.experiments import corner_free_cell
-from planner.clearance import Clearance, ClearanceError, clearance_for
-from planner.costmap import COST_WEIGHT, Costmap, centre_distances
-from planner.global_planner import plan_global
-from planner.grid_map import GridMap, MapError
-from planner.map_io import load_map, load_matrix_text, parse_text_grid
-from planner.random_map import random_map
+from planner.core.errors import MapError
+from planner.maps.clearance import Clearance, ClearanceError, clearance_for
+from planner.maps.costmap import COST_WEIGHT, Costmap, centre_distances
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
+from planner.maps.random_map import random_map
+from planner.maps.text_maps import load_matrix_text, parse_text_grid
+from planner.route.global_planner import plan_global
 from tests.footprint_check import MapView, centre_distance, dijkstra, path_cost
 
 CLEARANCE = Clearance(0.3, 0.2)

@@ -1,4 +1,4 @@
-"""The compiled hypot and remainder equal CPython's, bit for bit (planner.cpython_math)."""
+"""The compiled hypot and remainder equal CPython's, bit for bit (planner.core.cpython_math)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from planner.cpython_math import hypot, remainder
+from planner.core.cpython_math import hypot, remainder
 
 SPECIAL = [0.0, -0.0, 5e-324, -5e-324, 2.2250738585072014e-308, 1e-310, 1.0, -1.0, 1e308]
 

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from planner.distance_field import DistanceField, choose_subdivision
-from planner.grid_map import GridMap
+from planner.maps.distance_field import DistanceField, choose_subdivision
+from planner.maps.grid import GridMap
 
 TOLERANCE = 0.05
 

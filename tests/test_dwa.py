@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from planner.distance_field import DistanceField
-from planner.dwa import (
-    DwaConfig,
+from planner.core.motion import step_pose
+from planner.local.config import DwaConfig
+from planner.local.dwa import (
     DwaPlanner,
     _rollout,
     admissible_mask,
@@ -20,12 +20,12 @@ from planner.dwa import (
     route_offsets,
     sample_reach,
     static_clearance,
-    step_pose,
     window,
     window_axis,
 )
-from planner.dwa_scores import on_route, pairwise_sum, steady_choice
-from planner.grid_map import GridMap
+from planner.local.scores import on_route, pairwise_sum, steady_choice
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
 
 CFG = DwaConfig()
 DEG = math.pi / 180

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 
 from benchmarks.escape_search import search
 from fleet.moving_obstacle import MovingObstacle
-from planner.map_io import parse_text_grid
+from planner.maps.text_maps import parse_text_grid
 
 
 def test_a_walker_coming_straight_at_a_standing_agv_is_escaped_only_with_acceleration():

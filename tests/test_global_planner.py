@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from fleet.paper.experiments import corner_free_cell
-from planner.global_planner import plan_global
-from planner.grid_map import MapError
-from planner.key_nodes import drop_collinear, extract_key_nodes
-from planner.map_io import load_matrix_text, parse_text_grid
-from planner.path_metrics import path_length
-from planner.random_map import random_map
+from planner.core.errors import MapError
+from planner.core.path_metrics import path_length
+from planner.maps.random_map import random_map
+from planner.maps.text_maps import load_matrix_text, parse_text_grid
+from planner.route.global_planner import plan_global
+from planner.route.key_nodes import drop_collinear, extract_key_nodes
 from tests.segment_check import polyline_blocked_cells
 
 GRID20 = (

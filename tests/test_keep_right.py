@@ -1,4 +1,4 @@
-"""AGVs coming towards each other keep right (``planner.keep_right``), so that two mirror
+"""AGVs coming towards each other keep right (``planner.local.keep_right``), so that two mirror
 images of each other pass instead of mirroring each other's evasions."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import numpy as np
 
 from benchmarks import traffic_cases as tc
 from fleet.runtime.inprocess import run_in_process
-from planner.distance_field import DistanceField
-from planner.keep_right import MARGIN, agv_coming, right_offset, shifted_right
-from planner.map_io import parse_text_grid
+from planner.local.keep_right import MARGIN, agv_coming, right_offset, shifted_right
+from planner.maps.distance_field import DistanceField
+from planner.maps.text_maps import parse_text_grid
 
 RADIUS = 0.3
 

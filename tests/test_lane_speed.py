@@ -1,5 +1,5 @@
 """Along its route the default bounds the speed by the room to brake ahead, not by the
-clearance beside it (``planner.lane_speed``); off the route and near walkers, Eq. 7."""
+clearance beside it (``planner.local.lane_speed``); off the route and near walkers, Eq. 7."""
 
 from __future__ import annotations
 
@@ -10,11 +10,13 @@ import numpy as np
 
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario, with_profile
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner, step_pose
-from planner.lane_speed import node_room, route_room
-from planner.local_behaviour import local_behaviour
-from planner.map_io import parse_text_grid
+from planner.core.motion import step_pose
+from planner.local.behaviour import local_behaviour
+from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.local.lane_speed import node_room, route_room
+from planner.maps.distance_field import DistanceField
+from planner.maps.text_maps import parse_text_grid
 
 CFG = DwaConfig()  # Table 1: 0.2 m/s², so Eq. 7 at 0.2 m of clearance allows 0.28 m/s
 EQ7_AT_LANE = math.sqrt(2.0 * 0.2 * CFG.max_accel)

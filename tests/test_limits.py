@@ -11,10 +11,10 @@ import pytest
 
 from bridge import keys
 from bridge.messages import AgvState
-from planner.grid_map import MapError
-from planner.limits import MAX_MAP_CELLS
-from planner.map_io import load_map
-from planner.random_map import random_map
+from planner.core.errors import MapError
+from planner.core.limits import MAX_MAP_CELLS
+from planner.maps.loaders import load_map
+from planner.maps.random_map import random_map
 from recordings.reader import RecordingError, open_recording
 from recordings.writer import RecordingWriter
 

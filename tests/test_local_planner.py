@@ -25,17 +25,20 @@ from fleet.scenario import (
     parse_scenario,
     with_profile,
 )
-from planner.agv_status import BACK_OFF, RECOVERY, ROTATE, WAIT
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner, step_pose
-from planner.evasion import contact_times, evasive_index, into_wall
-from planner.fusion import FusionConfig, FusionController
-from planner.grid_map import GridMap
-from planner.local_behaviour import local_behaviour
-from planner.map_io import load_map, parse_text_grid
-from planner.parked_discs import blocking_cells, covered_cells
-from planner.recovery import RECOVERIES, away_from_obstacles, recovery_command
-from planner.route_check import blocked_point
+from planner.core.motion import step_pose
+from planner.core.status import BACK_OFF, RECOVERY, ROTATE, WAIT
+from planner.local.behaviour import local_behaviour
+from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.local.evasion import contact_times, evasive_index, into_wall
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
+from planner.maps.text_maps import parse_text_grid
+from planner.nav.fusion import FusionConfig, FusionController
+from planner.nav.recovery import RECOVERIES, away_from_obstacles, recovery_command
+from planner.route.parked_discs import blocking_cells, covered_cells
+from planner.route.route_check import blocked_point
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 from recordings.report import run_table

@@ -7,16 +7,11 @@ import math
 import numpy as np
 import pytest
 
-from planner.grid_map import MapError
-from planner.map_io import (
-    load_map,
-    load_matrix_text,
-    load_movingai,
-    load_movingai_scenarios,
-    load_ros_map,
-    parse_text_grid,
-    read_ros_map_info,
-)
+from planner.core.errors import MapError
+from planner.maps.loaders import load_map
+from planner.maps.movingai import load_movingai, load_movingai_scenarios
+from planner.maps.ros_map import load_ros_map, read_ros_map_info
+from planner.maps.text_maps import load_matrix_text, parse_text_grid
 
 # Obstacle counts stated in data/grid20/README.md.
 GRID20_OBSTACLES = {

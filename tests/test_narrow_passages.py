@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 
 from benchmarks import traffic_cases as tc
-from planner.centring import centred
-from planner.clearance import Clearance
-from planner.global_planner import plan_global
-from planner.grid_map import GridMap
-from planner.key_nodes import route_clearance
-from planner.random_map import random_map
+from planner.maps.clearance import Clearance
+from planner.maps.grid import GridMap
+from planner.maps.random_map import random_map
+from planner.maps.segment_clearance import route_clearance
+from planner.route.centring import centred
+from planner.route.global_planner import plan_global
 
 CLEARANCE = Clearance.from_safety_distance(0.3, 0.5)
 

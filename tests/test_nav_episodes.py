@@ -11,7 +11,7 @@ import numpy as np
 
 from benchmarks.nav_episodes import CROSSING_CLEAR, WALKER_RADIUS, episodes
 from fleet.scenario import parse_scenario
-from planner.distance_field import DistanceField
+from planner.maps.distance_field import DistanceField
 
 EPISODES = episodes(30)
 

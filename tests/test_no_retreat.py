@@ -1,5 +1,5 @@
 """Another AGV in reach: brake or step aside, never drive away from the target
-(``planner.no_retreat``)."""
+(``planner.local.no_retreat``)."""
 
 from __future__ import annotations
 
@@ -10,11 +10,12 @@ import numpy as np
 
 from benchmarks import traffic_cases as tc
 from fleet.runtime.inprocess import run_in_process
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner
-from planner.grid_map import GridMap
-from planner.local_behaviour import local_behaviour
-from planner.no_retreat import ahead_on_route, retreating
+from planner.local.behaviour import local_behaviour
+from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.local.no_retreat import ahead_on_route, retreating
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
 
 CONFIG = DwaConfig(
     max_speed=1.0, max_accel=0.5, max_omega=math.radians(60), max_alpha=math.radians(120)

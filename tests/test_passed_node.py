@@ -1,15 +1,15 @@
 """A key node gone past beside it, beyond its reach, with the next one in plain sight, is
-switched from, not turned back to (``planner.passed_node``)."""
+switched from, not turned back to (``planner.nav.passed_node``)."""
 
 from __future__ import annotations
 
 import math
 
-from planner.distance_field import DistanceField
-from planner.fusion import FusionConfig, FusionController
-from planner.map_io import parse_text_grid
-from planner.passed_node import in_plain_sight, passed_beside
-from planner.profiles import PAPER
+from planner.core.profiles import PAPER
+from planner.maps.distance_field import DistanceField
+from planner.maps.text_maps import parse_text_grid
+from planner.nav.fusion import FusionConfig, FusionController
+from planner.nav.passed_node import in_plain_sight, passed_beside
 
 # door n12 s3: R3 came out of the door at (10.5, 5.0), swerved north round an AGV waiting
 # beside its route and went by its key node 1.1 m off; its goal lay north-west

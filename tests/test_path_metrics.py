@@ -1,4 +1,5 @@
-"""Self-crossings of a driven path (an AGV's loops) and turn angles (``planner.path_metrics``)."""
+"""Self-crossings of a driven path (an AGV's loops) and turn angles
+(``planner.core.path_metrics``)."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import math
 
 import numpy as np
 
-from planner.path_metrics import (
+from planner.core.path_metrics import (
     LOOP_GAP,
     crossing_points,
     heading_changes_deg,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from planner.random_map import random_map
+from planner.maps.random_map import random_map
 
 
 def test_same_seed_same_map_other_seed_other_map():

@@ -17,10 +17,15 @@ from fleet.cli import main as cli_main
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.world import map_message
 from fleet.scenario import ScenarioError, load_scenario, parse_scenario, with_profile
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, DwaPlanner
-from planner.grid_map import GridMap, MapError
-from planner.map_io import load_map, load_movingai, load_ros_map, parse_text_grid
+from planner.core.errors import MapError
+from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
+from planner.maps.loaders import load_map
+from planner.maps.movingai import load_movingai
+from planner.maps.ros_map import load_ros_map
+from planner.maps.text_maps import parse_text_grid
 from recordings.reader import open_recording
 from recordings.series import extract, map_grid
 

@@ -12,9 +12,9 @@ import pytest
 from fleet.builtin import builtin_scenarios
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario, with_algorithm
-from planner.dwa import DwaConfig
-from planner.fusion import FusionConfig, FusionController
-from planner.map_io import parse_text_grid
+from planner.local.config import DwaConfig
+from planner.maps.text_maps import parse_text_grid
+from planner.nav.fusion import FusionConfig, FusionController
 
 FLEET = ("warehouse", "crossing", "corridor", "nav2-depot")
 PAPER_FUSION = (*(f"paper-temporary-{n}" for n in range(4)), "paper-dynamic")

@@ -20,7 +20,7 @@ from bridge.messages import (
 from bridge.struct_decoder import decode_valid
 from fleet.runtime.world import World
 from fleet.scenario import load_scenario
-from planner.traffic import Intent
+from planner.traffic.zones import Intent
 from tests.test_messages import STATE, samples
 
 INTENT = Intent(

@@ -1,5 +1,5 @@
 """Where the route turns into a 1.0 m corridor, the AGV does not cut the corner: it
-switches late, or stops at the node and turns on the spot (``planner.tight_turns``)."""
+switches late, or stops at the node and turns on the spot (``planner.nav.tight_turns``)."""
 
 from __future__ import annotations
 
@@ -10,13 +10,14 @@ from dataclasses import replace
 from benchmarks import traffic_cases as tc
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process
-from planner.distance_field import DistanceField
-from planner.dwa import DwaConfig, step_pose
-from planner.fusion import FusionConfig, FusionController
-from planner.grid_map import GridMap
-from planner.map_io import parse_text_grid
-from planner.path_metrics import turn_angle
-from planner.tight_turns import (
+from planner.core.motion import step_pose
+from planner.core.path_metrics import turn_angle
+from planner.local.config import DwaConfig
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
+from planner.maps.text_maps import parse_text_grid
+from planner.nav.fusion import FusionConfig, FusionController
+from planner.nav.tight_turns import (
     MIN_REACH,
     TURN_ON_SPOT,
     approach_command,

@@ -14,13 +14,14 @@ from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.world import World
 from fleet.scenario import load_scenario, parse_scenario
-from planner.clearance import Clearance
-from planner.costmap import Costmap
-from planner.dwa import DwaConfig
-from planner.map_io import parse_text_grid
-from planner.passages import NONE, Passages
-from planner.path_metrics import distance_to_path
-from planner.traffic import (
+from planner.core.path_metrics import distance_to_path
+from planner.local.config import DwaConfig
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.maps.text_maps import parse_text_grid
+from planner.traffic.guard import QUEUE_GAP, TrafficGuard
+from planner.traffic.passages import NONE, Passages
+from planner.traffic.zones import (  # fmt: skip
     BACK,
     CLEAR,
     GO,
@@ -31,8 +32,7 @@ from planner.traffic import (
     first_rival,
     may_enter,
     waiting_for,
-)  # fmt: skip
-from planner.traffic_guard import QUEUE_GAP, TrafficGuard
+)
 from recordings.analysis import analyze
 from recordings.reader import open_recording
 from recordings.rerun_view import save_rrd

@@ -14,8 +14,8 @@ from benchmarks import traffic_cases as tc
 from benchmarks.nav_episodes import body_path
 from bridge.messages import AgvState, Tick
 from fleet.scenario import parse_scenario
-from planner.costmap import point_clearance
-from planner.global_planner import plan_global
+from planner.maps.costmap import point_clearance
+from planner.route.global_planner import plan_global
 
 SEEDS = range(5)
 ALL = [tc.make_case(f, s) for f in tc.FAMILIES for s in SEEDS]

@@ -9,7 +9,7 @@ import signal
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
-from planner.traffic import DECISIONS, GO
+from planner.traffic.zones import DECISIONS, GO
 from tests.processes import agv_pid
 from tests.test_fleet_zenoh import hosted_world, state_key
 

@@ -19,7 +19,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # the world's end-of-run summary (its loop count), not a control cycle's: the world
 # process loads it once
-WORLD_ONLY = {"planner.path_metrics._crossings"}
+WORLD_ONLY = {"planner.core.path_metrics._crossings"}
 
 PROBE = textwrap.dedent(
     """

@@ -1,14 +1,14 @@
 """Which walkers make the AGV keep the room to yield, and where a head-on walker is
-taken to walk on (``planner.yielding``, ``planner.trail``)."""
+taken to walk on (``planner.local.yielding``, ``planner.nav.trail``)."""
 
 import math
 
 import numpy as np
 import pytest
 
-from planner.path_metrics import distance_to_path
-from planner.trail import TRAIL_LENGTH, TRAIL_STEP, Trail
-from planner.yielding import WALKER_RANGE, sweep, walker_coming, walker_near, walkers_standing
+from planner.core.path_metrics import distance_to_path
+from planner.local.yielding import WALKER_RANGE, sweep, walker_coming, walker_near, walkers_standing
+from planner.nav.trail import TRAIL_LENGTH, TRAIL_STEP, Trail
 
 POSE = (5.0, 5.0, 0.0)
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from planner.errors import BadInputError
+from planner.core.errors import BadInputError
 
 
 class UsageError(BadInputError):

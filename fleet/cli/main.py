@@ -14,7 +14,7 @@ from importlib.metadata import version
 
 from fleet import exit_codes
 from fleet.cli import nodes, paper, plan, recordings, replay, run, scenarios
-from planner.errors import AgvFleetError
+from planner.core.errors import AgvFleetError
 
 
 def build_parser() -> argparse.ArgumentParser:

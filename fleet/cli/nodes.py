@@ -32,8 +32,8 @@ from fleet.runtime.recorder_process import serve_recorder
 from fleet.runtime.world_server import START_TIMEOUT_S, WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S, WorldGone
 from fleet.scenario import load_scenario, with_algorithm, with_profile
-from planner.fusion import VARIANTS
-from planner.profiles import PROFILES
+from planner.core.profiles import PROFILES
+from planner.nav.fusion import VARIANTS
 from recordings.writer import RecordingWriter, default_recording_path
 
 

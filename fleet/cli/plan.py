@@ -10,11 +10,12 @@ from pathlib import Path
 from fleet import exit_codes
 from fleet.builtin import bundled_maps, resolve_map
 from fleet.cli.arguments import UsageError
-from planner.clearance import DEFAULT_MARGIN, DEFAULT_RADIUS, Clearance
-from planner.errors import BadInputError
-from planner.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up
-from planner.map_io import UNKNOWN_CHOICES, load_map
-from planner.profiles import DEFAULT, PROFILES
+from planner.core.errors import BadInputError
+from planner.core.profiles import DEFAULT, PROFILES
+from planner.maps.clearance import DEFAULT_MARGIN, DEFAULT_RADIUS, Clearance
+from planner.maps.loaders import load_map
+from planner.maps.ros_map import UNKNOWN_CHOICES
+from planner.route.global_planner import ALGORITHMS, PlanResult, plan_global, warm_up
 from recordings.text_table import text_table
 
 

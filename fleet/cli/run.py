@@ -19,8 +19,8 @@ from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import load_scenario, with_algorithm, with_profile
-from planner.fusion import VARIANTS
-from planner.profiles import PROFILES
+from planner.core.profiles import PROFILES
+from planner.nav.fusion import VARIANTS
 from recordings.rerun_server import RerunError
 from recordings.writer import default_recording_path
 

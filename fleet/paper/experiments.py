@@ -35,12 +35,12 @@ from fleet.runtime.agv_node import plan_message
 from fleet.runtime.inprocess import run_recorded
 from fleet.runtime.world import map_message
 from fleet.scenario import Scenario, load_scenario, with_algorithm, with_profile
-from planner.fusion import FusionConfig
-from planner.global_planner import DEFAULT_SAFETY_DISTANCE, plan_global, warm_up
-from planner.grid_map import GridMap
-from planner.map_io import load_matrix_text
-from planner.profiles import DEFAULT, PAPER
-from planner.random_map import random_map
+from planner.core.profiles import DEFAULT, PAPER
+from planner.maps.grid import GridMap
+from planner.maps.random_map import random_map
+from planner.maps.text_maps import load_matrix_text
+from planner.nav.fusion import FusionConfig
+from planner.route.global_planner import DEFAULT_SAFETY_DISTANCE, plan_global, warm_up
 from recordings.analysis import RunAnalysis, analyze
 from recordings.plan_metrics import MapPlans, map_plans
 from recordings.reader import open_recording

@@ -26,7 +26,7 @@ from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.agv_process import serve_agv
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
-from planner.errors import AgvFleetError
+from planner.core.errors import AgvFleetError
 
 _PR_SET_PDEATHSIG = 1
 

@@ -19,19 +19,18 @@ import numpy as np
 from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
-from planner.agv_status import FAILED, FINISHED
-from planner.clearance import Clearance
-from planner.costmap import Costmap
-from planner.dwa import step_pose
-from planner.fusion import FusionController
-from planner.global_planner import PlanResult, warm_up
-from planner.keep_right import agv_coming
-from planner.lane_speed import oncoming
-from planner.motion import moving_discs, wrap_angle
-from planner.no_retreat import retreating
-from planner.recovery import towards
-from planner.tight_turns import approach_command, approach_path
-from planner.traffic_guard import TrafficGuard
+from planner.core.motion import moving_discs, step_pose, wrap_angle
+from planner.core.status import FAILED, FINISHED
+from planner.local.keep_right import agv_coming
+from planner.local.lane_speed import oncoming
+from planner.local.no_retreat import retreating
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.nav.fusion import FusionController
+from planner.nav.recovery import towards
+from planner.nav.tight_turns import approach_command, approach_path
+from planner.route.global_planner import PlanResult, warm_up
+from planner.traffic.guard import TrafficGuard
 
 
 @dataclass

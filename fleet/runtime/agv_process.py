@@ -21,8 +21,8 @@ from bridge.messages import AgvCommand
 from fleet.runtime.agv_node import AgvNode, NodeOutput, publish_output
 from fleet.runtime.world_watch import WorldWatch
 from fleet.scenario import Scenario
-from planner.agv_status import FAILED
-from planner.errors import BadInputError
+from planner.core.errors import BadInputError
+from planner.core.status import FAILED
 
 POLL_S = 0.05
 

@@ -35,7 +35,7 @@ from fleet.runtime.world import World
 from fleet.runtime.world_server import WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
-from planner.errors import EnvironmentFailure
+from planner.core.errors import EnvironmentFailure
 from recordings.reader import held_seconds
 
 EXIT_GRACE_S = 5.0

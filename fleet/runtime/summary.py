@@ -6,11 +6,11 @@ import math
 from dataclasses import dataclass
 
 from fleet.runtime.world import World
-from planner.agv_status import ARRIVED, FINISHED
-from planner.fusion import GLOBAL_ALGORITHM
-from planner.global_planner import plan_global
-from planner.grid_map import MapError
-from planner.path_metrics import self_crossings
+from planner.core.errors import MapError
+from planner.core.path_metrics import self_crossings
+from planner.core.status import ARRIVED, FINISHED
+from planner.nav.fusion import GLOBAL_ALGORITHM
+from planner.route.global_planner import plan_global
 from recordings.text_table import text_table
 
 

@@ -2,7 +2,7 @@
 
 The world derives them from each AGV's intent (the AGVs decide, the world reports),
 so both run modes record the same events. An event's kind is the phase the AGV
-entered (``planner.traffic.DECISIONS``): ``wait`` (held outside a passage another
+entered (``planner.traffic.zones.DECISIONS``): ``wait`` (held outside a passage another
 AGV has; the event names whom it waits for), ``go`` (a waiting AGV may enter),
 ``yield`` (a holder is stuck: a waiting AGV moves further back to make room),
 ``back`` (two AGVs met inside a passage going opposite ways: the later one backs out;
@@ -12,7 +12,7 @@ a deadlock broken).
 from __future__ import annotations
 
 from bridge.messages import Event
-from planner.traffic import BACK, GO, WAIT, YIELD, Intent
+from planner.traffic.zones import BACK, GO, WAIT, YIELD, Intent
 
 
 def traffic_events(before: Intent | None, now: Intent, tick: int, time: float) -> list[Event]:

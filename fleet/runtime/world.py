@@ -18,14 +18,13 @@ import numpy as np
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
-from planner.agv_status import ARRIVED, DRIVING, FAILED, FINISHED, RECOVERY, WAITING
-from planner.distance_field import DistanceField
-from planner.dwa import step_pose
-from planner.grid_map import GridMap
-from planner.motion import limit_command
-from planner.profiles import PAPER
-from planner.traffic import Intent
-from planner.traffic_guard import ROUTE_POINTS
+from planner.core.motion import limit_command, step_pose
+from planner.core.profiles import PAPER
+from planner.core.status import ARRIVED, DRIVING, FAILED, FINISHED, RECOVERY, WAITING
+from planner.maps.distance_field import DistanceField
+from planner.maps.grid import GridMap
+from planner.traffic.guard import ROUTE_POINTS
+from planner.traffic.zones import Intent
 
 INTERRUPTED = "interrupted"  # the end reason of a run ended by Ctrl-C or SIGTERM
 

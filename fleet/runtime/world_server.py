@@ -28,7 +28,7 @@ from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
-from planner.errors import EnvironmentFailure
+from planner.core.errors import EnvironmentFailure
 
 POLL_S = 0.02
 RESEND_S = 0.5  # while an AGV is lost, tick k goes out again this often

@@ -17,7 +17,7 @@ import time
 from bridge import keys
 from bridge.bus import Bus
 from bridge.session import refuses
-from planner.errors import EnvironmentFailure
+from planner.core.errors import EnvironmentFailure
 
 PROBE_EVERY_S = 0.5
 # how long a lost link may last before the world fails an AGV (and an AGV or the

@@ -1,0 +1,3 @@
+"""The vocabulary every layer shares: errors, input limits, statuses, profiles, the
+motion model (Eq. 4) and polyline geometry. Imports nothing of ``planner``.
+"""
