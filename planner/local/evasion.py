@@ -25,9 +25,9 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0
     """(N,) times of each trajectory's first contact with the static map and with a moving
     disc (inf: none), (N,) its lowest clearance.
 
-    ``xs``, ``ys`` (N, K) as in ``dwa.static_clearance``, on a distance field whose map
+    ``xs``, ``ys`` (N, K) as in ``clearance.static_clearance``, on a distance field whose map
     origin is (``ox``, ``oy``); moving discs (M, 5) rows
-    [x, y, vx, vy, r] at constant velocity. Unlike ``dwa.lower_by_discs`` the whole
+    [x, y, vx, vy, r] at constant velocity. Unlike ``clearance.lower_by_discs`` the whole
     horizon is evaluated, so the lowest clearance ranks trajectories in contact.
     """
     n_traj, n_steps = xs.shape

@@ -126,3 +126,14 @@ def stop_room(distance: float, behind: float, speed: np.ndarray, horizon_s: floa
     ``speed`` runs past the place and must stop short of what stands behind it, else
     near the place every fast sample touches the wall behind and none is admissible."""
     return np.maximum(np.minimum(distance, distance + behind - speed * horizon_s), 0.0)
+
+
+@numba.njit(cache=True)
+def on_route_room(offsets, braking, clearance, tolerance):
+    """``braking`` where a sample follows the route (within ``tolerance``) and it exceeds
+    the clearance, else 0: numpy's ``where`` of the two tests, in one call."""
+    out = np.empty(len(braking))
+    for i in range(len(braking)):
+        follows = offsets[i] <= tolerance and braking[i] > clearance[i]
+        out[i] = braking[i] if follows else 0.0
+    return out

@@ -11,7 +11,7 @@ predictable to it, one that flees keeps it coming. So while another AGV can
 lower a sample's clearance, the samples whose displacement over the horizon
 points away from the target by more than ``RETREAT_ANGLE`` are dropped; with
 nothing else admissible the AGV brakes (as DWA does when only AGVs are in reach,
-``DwaPlanner._evade_from``). Walkers do not plan: from them the AGV still backs
+``planner.local.fallback.Evade``). Walkers do not plan: from them the AGV still backs
 off (``planner.local.yielding``).
 
 "Away" is measured from where the route goes on (``ahead_on_route``), not from the
