@@ -77,8 +77,8 @@ def evasive_index(
     the AGV creeping, in reach of the walker it is fleeing, wherever it has walls around.
     But once a walker has pinned the AGV against a wall, every sample touches one at
     once; the lowest clearance alone (a walker overlapping the AGV by 0.37 m outweighs a
-    wall) then drove it 0.3 m into the corner where two wall cells meet (nav_bench seed
-    282), which no vehicle can do: those samples come last.
+    wall) then drove it 0.3 m into the corner where two wall cells meet, which no
+    vehicle can do: those samples come last.
     """
     committed = static_first <= 2.0 * speeds / max_accel + dt
     return int(np.lexsort((-lowest, -moving_first, committed, entering))[0])
