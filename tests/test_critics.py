@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from planner.local.admissible import admissible_mask
 from planner.local.behaviour import DEFAULT_BEHAVIOUR, PAPER_BEHAVIOUR, local_behaviour
 from planner.local.candidates import Candidates
 from planner.local.choice import pick, weighed
@@ -53,7 +54,8 @@ def samples(commands, ends, clearance=None, offsets=None, lowering=NO_DISCS) -> 
     offsets = None if offsets is None else np.array(offsets, float)
     return Samples(
         commands, paths[:, :, 0].copy(), paths[:, :, 1].copy(), paths[:, :, 2].copy(),
-        clearance, clearance, clearance, offsets, NO_DISCS, lowering, 1.0,
+        clearance, clearance, clearance, admissible_mask(CFG, commands, clearance), offsets,
+        NO_DISCS, lowering, 1.0,
         float(clearance.max()),
     )  # fmt: skip
 

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from planner.core.motion import step_pose
+from planner.local.admissible import admissible_mask
 from planner.local.choice import steady_choice
 from planner.local.clearance import lower_by_discs, static_clearance
 from planner.local.config import DwaConfig
 from planner.local.critics.route import on_route
 from planner.local.dwa import DwaPlanner
-from planner.local.filters import admissible_mask
 from planner.local.normalise import pairwise_sum
 from planner.local.rollout import rollout, rollout_turns, route_offsets, sample_reach
 from planner.local.window import braking_command, dynamic_window, window, window_axis

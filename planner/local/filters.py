@@ -20,11 +20,9 @@ import math
 from dataclasses import dataclass
 from typing import Protocol
 
-import numba
 import numpy as np
 
 from planner.core.physics import braking_speed
-from planner.local.config import DwaConfig
 from planner.local.cycle import Cycle
 from planner.local.no_retreat import ahead_on_route, retreating
 from planner.local.samples import Samples
@@ -48,41 +46,13 @@ class Admissible:
     """Eq. (7) plus no contact: the AGV can brake to zero within the trajectory's clearance
     (Fox et al.'s minimum over the trajectory; the paper says "from its end", the minimum
     is the safe reading). The linear speed is bounded by the samples' ``room`` (the lane's
-    braking room along the route, else the clearance), the turn rate by the clearance."""
+    braking room along the route, else the clearance), the turn rate by the clearance
+    (``planner.local.admissible``)."""
 
     name: str = "admissible"
 
     def narrow(self, mask: np.ndarray, samples: Samples, cycle: Cycle) -> np.ndarray:
-        cfg = cycle.config
-        s = samples
-        return mask & admissible(s.commands, s.clearance, s.room, cfg.max_accel, cfg.max_alpha)
-
-
-def admissible_mask(
-    config: DwaConfig,
-    commands: np.ndarray,
-    clearance: np.ndarray,
-    braking_room: np.ndarray | None = None,
-) -> np.ndarray:
-    """``Admissible``'s mask of ``commands`` with ``clearance``; ``braking_room`` (the
-    lane's) replaces the clearance in the linear speed's bound."""
-    linear = clearance if braking_room is None else braking_room
-    return admissible(commands, clearance, linear, config.max_accel, config.max_alpha)
-
-
-@numba.njit(cache=True)
-def admissible(commands, clearance, linear, max_accel, max_alpha):
-    """``admissible_mask``, compiled: ``linear`` is the room bounding the linear speed."""
-    mask = np.empty(len(commands), dtype=np.bool_)
-    for i in range(len(commands)):
-        room = max(clearance[i], 0.0)
-        speed = np.hypot(commands[i, 0], commands[i, 1])
-        mask[i] = (
-            clearance[i] > 0.0
-            and speed <= braking_speed(max(linear[i], 0.0), max_accel) + _EPS
-            and abs(commands[i, 2]) <= braking_speed(room, max_alpha) + _EPS
-        )
-    return mask
+        return mask & samples.admissible  # computed with the samples, in their compiled call
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from planner.local.admissible import admissible
 from planner.local.clearance import discs_by_gap, lower_by_discs, static_clearance
 from planner.local.cycle import Cycle
 from planner.local.lane_speed import (
@@ -40,6 +41,7 @@ class Samples:
     ``commands`` (N, 3); ``xs``, ``ys``, ``thetas`` (N, K) the poses after steps 1..K;
     ``walls`` the least clearance to the map, ``clearance`` with the moving discs too;
     ``room`` what bounds the linear speed (Eq. 7's clearance, or the lane's braking room);
+    ``admissible`` Eq. (7)'s mask (``planner.local.admissible``: the ``Admissible`` filter's);
     ``offsets`` how far each strays from the route segment (None: not asked). Of the
     discs (sorted nearest first), ``in_reach`` are those in reach of the fastest sample
     the lane admits (the fallback looks at them) and ``lowering`` those that lower some
@@ -54,6 +56,7 @@ class Samples:
     walls: np.ndarray
     clearance: np.ndarray
     room: np.ndarray
+    admissible: np.ndarray
     offsets: np.ndarray | None
     in_reach: np.ndarray
     lowering: np.ndarray
@@ -82,29 +85,31 @@ class Samples:
             float(pose[0]), float(pose[1]), float(pose[2]), vx, vy, omega,
             cfg.min_vx, cfg.max_speed, cfg.max_omega, cfg.max_accel * cfg.dt,
             cfg.max_alpha * cfg.dt, cfg.v_resolution, cfg.omega_resolution, cfg.dt, cfg.steps,
-            cfg.horizon_s, cfg.radius, field.samples, 1.0 / field.spacing, *field.origin,
+            cfg.horizon_s, cfg.radius, cfg.max_accel, cfg.max_alpha, field.samples,
+            1.0 / field.spacing, *field.origin,
             cycle.discs, lane, room, lane and cycle.stop, cycle.distance, behind,
             offsets_wanted, float(ax), float(ay), float(bx - ax), float(by - ay),
         )  # fmt: skip
-        commands, paths, walls, clearance, linear, offsets, in_reach, lowering, span, best = out
+        commands, paths, walls, clearance, linear, eq7, offsets, in_reach, lowering = out[:9]
         return cls(
-            commands, paths[0], paths[1], paths[2], walls, clearance, linear,
-            offsets if offsets_wanted else None, in_reach, lowering, span, best,
+            commands, paths[0], paths[1], paths[2], walls, clearance, linear, eq7,
+            offsets if offsets_wanted else None, in_reach, lowering, *out[9:],
         )  # fmt: skip
 
 
 @numba.njit(cache=True)
 def roll_out_window(
     x, y, theta, vx, vy, omega, min_vx, max_speed, max_omega, dv, dw, v_step, omega_step,
-    dt, steps, horizon_s, radius, samples, inv_spacing, ox, oy, discs,
+    dt, steps, horizon_s, radius, max_accel, max_alpha, samples, inv_spacing, ox, oy, discs,
     lane, room, stopping, distance, behind, offsets_wanted, ax, ay, dx, dy,
 ):  # fmt: skip
     """``Samples.of``'s arrays in one compiled call: the window's commands, their
     trajectories (3, N, K), each one's least clearance to the map (``walls``) and with the
-    moving ``discs`` (sorted nearest first, as ``relevant_discs``), the room bounding
-    its linear speed, the route offsets (when ``offsets_wanted``; else empty), the discs in
-    reach of the fastest sample the lane admits, those that can lower a clearance below the
-    best static one, the samples' reach and that best clearance.
+    moving ``discs`` (sorted nearest first, as ``relevant_discs``), the room bounding its
+    linear speed, Eq. (7)'s admissible mask, the route offsets (when ``offsets_wanted``;
+    else empty), the discs in reach of the fastest sample the lane admits, those that can
+    lower a clearance below the best static one, the samples' reach and that best
+    clearance.
 
     With a ``lane`` (``planner.local.lane_speed``) the linear speed of the samples that follow
     the route segment (from (ax, ay) along (dx, dy)) is bounded by their room to brake
@@ -147,4 +152,8 @@ def roll_out_window(
         if len(near):
             braking = lower_by_discs(xs, ys, braking, near, dt, radius)
         linear = np.maximum(braking, clearance)
-    return commands, paths, walls, clearance, linear, offsets, reached, lowering, span, static_best
+    mask = admissible(commands, clearance, linear, max_accel, max_alpha)
+    return (
+        commands, paths, walls, clearance, linear, mask, offsets, reached, lowering, span,
+        static_best,
+    )  # fmt: skip
