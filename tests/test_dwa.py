@@ -8,22 +8,15 @@ import numpy as np
 import pytest
 
 from planner.core.motion import step_pose
+from planner.local.admissible import admissible_mask
+from planner.local.choice import steady_choice
+from planner.local.clearance import lower_by_discs, static_clearance
 from planner.local.config import DwaConfig
-from planner.local.dwa import (
-    DwaPlanner,
-    _rollout,
-    admissible_mask,
-    braking_command,
-    dynamic_window,
-    lower_by_discs,
-    rollout,
-    route_offsets,
-    sample_reach,
-    static_clearance,
-    window,
-    window_axis,
-)
-from planner.local.scores import on_route, pairwise_sum, steady_choice
+from planner.local.critics.route import on_route
+from planner.local.dwa import DwaPlanner
+from planner.local.normalise import pairwise_sum
+from planner.local.rollout import rollout, rollout_turns, route_offsets, sample_reach
+from planner.local.window import braking_command, dynamic_window, window, window_axis
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import GridMap
 
@@ -140,8 +133,10 @@ def test_the_windows_turn_rates_roll_out_as_a_search_for_them_would(command):
     np.testing.assert_array_equal(samples.which, which)
     pose = (3.0, 4.0, 0.7)
     x, y, theta = pose
-    np.testing.assert_array_equal(  # how a control cycle rolls them out (``_evaluate``)
-        _rollout(x, y, theta, samples.commands, samples.omegas, samples.which, CFG.dt, CFG.steps),
+    np.testing.assert_array_equal(  # how a control cycle rolls them out (``Samples.of``)
+        rollout_turns(
+            x, y, theta, samples.commands, samples.omegas, samples.which, CFG.dt, CFG.steps
+        ),
         rollout(pose, samples.commands, CFG.dt, CFG.steps),
     )
 

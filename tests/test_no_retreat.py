@@ -13,6 +13,7 @@ from fleet.runtime.inprocess import run_in_process
 from planner.local.behaviour import local_behaviour
 from planner.local.config import DwaConfig
 from planner.local.dwa import DwaPlanner
+from planner.local.filters import NoRetreat
 from planner.local.no_retreat import ahead_on_route, retreating
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import GridMap
@@ -21,7 +22,9 @@ CONFIG = DwaConfig(
     max_speed=1.0, max_accel=0.5, max_omega=math.radians(60), max_alpha=math.radians(120)
 )
 DEFAULT = local_behaviour("default")
-WITHOUT = dataclasses.replace(DEFAULT, no_retreat=False)
+WITHOUT = dataclasses.replace(
+    DEFAULT, filters=tuple(f for f in DEFAULT.filters if not isinstance(f, NoRetreat))
+)
 
 
 def _retreats(pose, end, target) -> bool:

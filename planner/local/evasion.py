@@ -25,9 +25,9 @@ def contact_times(xs, ys, samples, inv_spacing, moving, dt, radius, ox=0.0, oy=0
     """(N,) times of each trajectory's first contact with the static map and with a moving
     disc (inf: none), (N,) its lowest clearance.
 
-    ``xs``, ``ys`` (N, K) as in ``dwa.static_clearance``, on a distance field whose map
+    ``xs``, ``ys`` (N, K) as in ``clearance.static_clearance``, on a distance field whose map
     origin is (``ox``, ``oy``); moving discs (M, 5) rows
-    [x, y, vx, vy, r] at constant velocity. Unlike ``dwa.lower_by_discs`` the whole
+    [x, y, vx, vy, r] at constant velocity. Unlike ``clearance.lower_by_discs`` the whole
     horizon is evaluated, so the lowest clearance ranks trajectories in contact.
     """
     n_traj, n_steps = xs.shape
@@ -77,8 +77,8 @@ def evasive_index(
     the AGV creeping, in reach of the walker it is fleeing, wherever it has walls around.
     But once a walker has pinned the AGV against a wall, every sample touches one at
     once; the lowest clearance alone (a walker overlapping the AGV by 0.37 m outweighs a
-    wall) then drove it 0.3 m into the corner where two wall cells meet (nav_bench seed
-    282), which no vehicle can do: those samples come last.
+    wall) then drove it 0.3 m into the corner where two wall cells meet, which no
+    vehicle can do: those samples come last.
     """
     committed = static_first <= 2.0 * speeds / max_accel + dt
     return int(np.lexsort((-lowest, -moving_first, committed, entering))[0])

@@ -3,8 +3,8 @@
 Two AGVs that meet head-on where there is room for both (a corridor 1.5 m wide,
 an aisle) each follow the same centred route. DWA treats the other as a moving
 disc, and two mirror-image AGVs make mirror-image choices: they stepped the same
-way, backed off, turned, met again (traffic suite corridor-3-mirror n2 s0: 40 s
-of dancing in the corridor's middle before they passed). A convention breaks the
+way, backed off, turned, met again (two mirror-image AGVs in a corridor: 40 s of
+dancing in its middle before they passed). A convention breaks the
 symmetry without talking: while an AGV comes towards it, each follows its route
 shifted to its right, by as much as the free space beside the route allows
 (``right_offset``); the route's own key nodes, switching and corners are unchanged.

@@ -2,8 +2,8 @@
 
 Eq. (7) bounds a sample's speed by its trajectory's least clearance, so an AGV
 that faces its travel along a wall 0.2 m away may go sqrt(2 a 0.2) = 0.28 m/s
-at Table 1's limits, however clear the way ahead (the built-in ``corridor``:
-77 s where the paper, sliding sideways to the middle, took 52 s). Fox et al.'s
+at Table 1's limits, however clear the way ahead (along a corridor, half as long
+again as the paper's DWA, which slides sideways to the middle first). Fox et al.'s
 rule bounds it by the distance the AGV can still travel without contact, which
 a wall beside the lane does not shorten.
 
@@ -40,6 +40,7 @@ import numpy as np
 
 from planner.core.motion import turned_velocity
 from planner.core.path_metrics import turn_angle
+from planner.core.physics import braking_distance
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import Point
 
@@ -89,8 +90,7 @@ def route_room(
 def braking_room(speed: float, max_accel: float, dt: float) -> float:
     """The room (m) to stop from ``speed`` less one period of the hardest deceleration:
     granted, only the samples that brake that hard, or that Eq. (7) admits, stay admissible."""
-    slower = max(0.0, speed - max_accel * dt)
-    return slower * slower / (2.0 * max_accel)
+    return braking_distance(max(0.0, speed - max_accel * dt), max_accel)
 
 
 def oncoming(pose, command, moving, max_accel: float, horizon_s: float) -> bool:
@@ -126,3 +126,14 @@ def stop_room(distance: float, behind: float, speed: np.ndarray, horizon_s: floa
     ``speed`` runs past the place and must stop short of what stands behind it, else
     near the place every fast sample touches the wall behind and none is admissible."""
     return np.maximum(np.minimum(distance, distance + behind - speed * horizon_s), 0.0)
+
+
+@numba.njit(cache=True)
+def on_route_room(offsets, braking, clearance, tolerance):
+    """``braking`` where a sample follows the route (within ``tolerance``) and it exceeds
+    the clearance, else 0: numpy's ``where`` of the two tests, in one call."""
+    out = np.empty(len(braking))
+    for i in range(len(braking)):
+        follows = offsets[i] <= tolerance and braking[i] > clearance[i]
+        out[i] = braking[i] if follows else 0.0
+    return out

@@ -4,21 +4,21 @@ DWA treats another AGV as a disc moving on at its velocity. Against a disc
 coming its way, the samples that keep the most clearance over the horizon are
 those that run ahead of it: an AGV met head-on in a 2 m aisle turned and drove
 off with the other behind it, circled back, met the next one and circled again
-(traffic suite warehouse-40 n40 s0: agv9 circled in the cross aisle for 40 s,
-its path crossing itself 12 times); in a corridor an AGV backed out metres ahead of
+(in a crowded warehouse an AGV circled in a cross aisle for 40 s, its path
+crossing itself 12 times); in a corridor an AGV backed out metres ahead of
 an oncoming pair. The other AGV plans too: one that brakes or steps aside is
 predictable to it, one that flees keeps it coming. So while another AGV can
 lower a sample's clearance, the samples whose displacement over the horizon
 points away from the target by more than ``RETREAT_ANGLE`` are dropped; with
 nothing else admissible the AGV brakes (as DWA does when only AGVs are in reach,
-``DwaPlanner._evade_from``). Walkers do not plan: from them the AGV still backs
+``planner.local.fallback.Evade``). Walkers do not plan: from them the AGV still backs
 off (``planner.local.yielding``).
 
 "Away" is measured from where the route goes on (``ahead_on_route``), not from the
 target as the crow flies: an AGV pushed off its route into a side aisle, with its
 target beyond a shelf, otherwise counted driving on down that aisle as a step
-aside (warehouse-40 n40 s4: agv22 fled 3 m down its side aisle, came back and
-crossed its own path five times).
+aside (an AGV pushed into a side aisle fled 3 m down it, came back and crossed
+its own path five times).
 """
 
 from __future__ import annotations

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from planner.core.motion import Command
+from planner.core.physics import braking_speed
 from planner.local.config import DwaConfig
 
 ALIGNED = math.radians(2.0)  # rad: a heading error this small counts as aligned
@@ -22,7 +23,7 @@ def turn_command(config: DwaConfig, error: float, command: Command) -> Command |
         return None
     dw, dv = config.max_alpha * config.dt, config.max_accel * config.dt
     wanted = math.copysign(
-        min(config.max_omega, math.sqrt(2 * config.max_alpha * abs(error))), error
+        min(config.max_omega, braking_speed(abs(error), config.max_alpha)), error
     )
     new_omega = omega + min(max(wanted - omega, -dw), dw)
     vx, vy = command[0], command[1]

@@ -15,9 +15,9 @@ disc on the AGV's remaining route and walking against it is taken to follow
 the route towards the AGV (a walker keeps to the aisle it walks in; a
 straight line would leave the route at its first bend and miss the AGV), and
 on past the AGV along the way the AGV came. Without that way, the sweep ended
-at the AGV, and backing off along its own tracks looked clear: in nav_bench's
-held-out seed 211 the AGV fled 2 m back down its aisle ahead of a head-on
-walker, which caught it up there.
+at the AGV, and backing off along its own tracks looked clear: an AGV met
+head-on by a walker in an aisle fled 2 m back down it ahead of the walker,
+which caught it up there.
 """
 
 from __future__ import annotations
@@ -175,7 +175,7 @@ def walker_coming(pose, walkers) -> bool:
 
     One that walks away has passed, or never came: an AGV that let it by from a bay and
     kept crawling there (the steady choice, with no speeding up near a walker) was still
-    in the bay 1 s later when the walker turned off the route into it (nav_bench seed 40).
+    in the bay 1 s later when the walker turned off the route into it.
     A standing walker counts as coming: it may start towards the AGV at any time.
     """
     near = _walkers_in_range(pose, walkers)

@@ -49,10 +49,11 @@ from planner.core.profiles import DEFAULT, check_profile
 from planner.core.status import BACK_OFF, REPLAN, ROTATE, WAIT, WAITING
 from planner.local.behaviour import local_behaviour
 from planner.local.config import DwaConfig
-from planner.local.dwa import DwaPlanner, braking_command
+from planner.local.dwa import DwaPlanner
 from planner.local.keep_right import agv_coming, right_offset, shifted_right
 from planner.local.lane_speed import oncoming, route_room
 from planner.local.turning import turn_command
+from planner.local.window import braking_command
 from planner.local.yielding import agvs_of, walker_near, walkers_standing
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
