@@ -17,15 +17,20 @@ GLOBAL_ALGORITHM = {"fusion": "improved", "astar-dwa": "traditional"}
 
 @dataclass(frozen=True)
 class FusionConfig:
-    """Everything one AGV's planner needs; defaults are the paper's."""
+    """Everything one AGV's planner needs; defaults are the paper's. Each is a scenario key
+    (``scenarios/README.md``)."""
 
     algorithm: str = "fusion"
     profile: str = DEFAULT
     dwa: DwaConfig = field(default_factory=DwaConfig)
     safety_distance: float = DEFAULT_SAFETY_DISTANCE
+    # m: the next key node becomes the local target within this of the current one: early
+    # enough that DWA rounds the corner instead of stopping on it
     switch_distance: float = 1.0
-    goal_tolerance: float = 0.2
-    progress_window: float = 5.0
+    goal_tolerance: float = 0.2  # m: arrived within it
+    progress_window: float = 5.0  # s: no progress for this long is a stall (replan, recover)
+    # m: the remaining route must shrink by this much to count as progress: more than an
+    # AGV dithering on the spot gains
     progress_distance: float = 0.3
     approach_distance: float = 3.0  # m: the final approach starts this close to the goal
     free_heading: bool = False  # default profile: keep the paper's free heading
