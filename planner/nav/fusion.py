@@ -42,12 +42,10 @@ from planner.core.motion import wrap_angle
 from planner.core.status import BLOCKED, DRIVING, REPLAN, WAITING
 from planner.local.behaviour import local_behaviour
 from planner.local.dwa import DwaPlanner, braking_command
-from planner.local.keep_right import agv_coming, right_offset, shifted_right
-from planner.local.lane_speed import oncoming, route_room
 from planner.local.turning import turn_command
-from planner.local.yielding import agvs_of, walker_near, walkers_standing
 from planner.maps.grid import GridMap, Point
 from planner.nav.config import GLOBAL_ALGORITHM, VARIANTS, FusionConfig
+from planner.nav.dwa_inputs import lane_room, route_segment, straight_approach
 from planner.nav.goal_checker import GoalChecker
 from planner.nav.key_node_targets import KeyNodeTargets
 from planner.nav.mode import Mode
@@ -55,7 +53,7 @@ from planner.nav.plan_keeper import PlanKeeper
 from planner.nav.progress_checker import ProgressChecker
 from planner.nav.recovery import DURATION_S, recovery_command
 from planner.nav.recovery_sequence import RecoverySequence, agv_near
-from planner.nav.tight_turns import Corner, approach_command, approach_path
+from planner.nav.tight_turns import Corner
 from planner.nav.trail import Trail
 from planner.nav.turn_round import FACED, TurnRound
 from planner.route.global_planner import PlanResult
@@ -376,69 +374,18 @@ class FusionController:
         return _step(cmd, DRIVING, first)
 
     def _segment(self, pose, target: Point, moving, walkers):
-        """The route's current segment for DWA's on-route term, shifted to the right while
-        another AGV comes the other way (``planner.local.keep_right``)."""
         segment = (self.key_nodes.segment_start(), target)
-        if not self.behaviour.keep_right:
-            return segment
-        field, radius = self.dwa.distance_field, self.config.dwa.radius
-        if not agv_coming(pose[:2], segment, radius, agvs_of(moving, walkers)):
-            return segment
-        return shifted_right(segment, right_offset(field, radius, segment))
+        return route_segment(self.behaviour, self.config, self.dwa, segment, pose, moving, walkers)
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
-        """The command and predicted path of the straight approach to a tight corner, when
-        within ``approach_distance``, no walker is near (``walker_near``; walkers standing
-        still may be, once the AGV stalled before this corner) and, driven no faster than it
-        can brake within its clearance (Eq. 7, as DWA's samples), it keeps clear of the map
-        and the moving discs over the horizon; None: DWA drives (and avoids).
-
-        A walker in range keeps the approach off because it stops and turns at the corner,
-        slow to get out of a walker's way. But a walker that stopped where its walk ended
-        may stand there for good, and a 1-cell gap that DWA's arcs cannot thread then
-        failed the run (a walker parked in a gap on held-out nav_bench episodes)."""
-        if math.dist(pose[:2], node) > self.config.approach_distance:
-            return None
-        if walker_near(pose, walkers) and not self._stuck_past_standing(node, pose, walkers):
-            return None
-        cfg = self.config.dwa
-        room = self.dwa.clearance_along(
-            approach_path(cfg, pose, command, node, cfg.max_speed), moving
+        return straight_approach(
+            self.config, self.dwa, pose, command, node, moving, walkers, self._stalled_before
         )
-        if room <= 0.0:
-            return None
-        cap = math.sqrt(2.0 * room * cfg.max_accel)  # the approach keeps below Eq. (7)'s limit
-        path = approach_path(cfg, pose, command, node, cap)
-        if self.dwa.clearance_along(path, moving) <= 0.0:
-            return None
-        return approach_command(cfg, pose, command, node, cap), path
-
-    def _stuck_past_standing(self, node: Point, pose, walkers) -> bool:
-        """Whether the AGV stalled before on its way to ``node`` and every walker in range
-        stands still."""
-        before = self._stalled_before
-        stuck = before is not None and math.dist(before, node) < self.config.goal_tolerance
-        return stuck and walkers_standing(pose, walkers)
 
     def _lane_room(self, pose, command, moving, walkers, nodes: list[Point] | None = None):
-        """The braking room the route ahead (or ``nodes``) grants DWA's samples that follow
-        it (``planner.local.lane_speed``). With a walker near or a disc coming (``oncoming``),
-        none: DWA still grants the hardest braking from the current speed, so the AGV slows
-        to Eq. (7)'s speed, keeping the room to yield or pass, instead of finding nothing
-        admissible at once."""
-        if not self.behaviour.lane_speed:
-            return None
-        cfg = self.config
-        if walker_near(pose, walkers) or oncoming(
-            pose, command, moving, cfg.dwa.max_accel, cfg.dwa.horizon_s
-        ):
-            return 0.0
+        corners = self.corners[self.key_nodes.index :]
         if nodes is None:
             nodes = self.key_nodes.ahead()
-        # a tight corner's bound applies from where its straight approach begins
-        corners = self.corners[self.key_nodes.index :] if len(nodes) > 1 else []
-        reaches = [cfg.approach_distance if c.stop else c.reach for c in corners]
-        horizon = cfg.dwa.max_speed**2 / (2.0 * cfg.dwa.max_accel)
-        return route_room(
-            self.dwa.distance_field, cfg.dwa.radius, (pose[0], pose[1]), nodes, reaches, horizon
+        return lane_room(
+            self.behaviour, self.config, self.dwa, pose, command, moving, walkers, nodes, corners
         )
