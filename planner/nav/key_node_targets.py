@@ -16,6 +16,8 @@ import itertools
 import math
 from collections.abc import Callable
 
+import numpy as np
+
 from planner.core.motion import Command, Pose
 from planner.local.behaviour import LocalBehaviour
 from planner.maps.distance_field import DistanceField
@@ -24,7 +26,7 @@ from planner.nav.config import FusionConfig
 from planner.nav.passed_node import in_plain_sight, passed_beside
 from planner.nav.tight_turns import Corner, corners, stopped_enough
 
-Approach = tuple[Command, object]
+Approach = tuple[Command, np.ndarray]
 """A straight approach to a node: its command and its predicted (K, 3) path."""
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import enum
 
+from planner.core import status
+
 
 class Mode(enum.Enum):
     """The controller's state between control cycles.
@@ -13,15 +15,16 @@ class Mode(enum.Enum):
     coming: evading beats finishing the turn). DRIVING -> RECOVERING: the progress checker
     found no progress and the recovery sequence started a timed recovery; back to DRIVING
     when its time is up. DRIVING <-> WAITING: the traffic rule holds the AGV at a waiting
-    place, for as long as it holds it. ARRIVED and FAILED end the run.
+    place, for as long as it holds it. ARRIVED and FAILED end the run; their values are
+    the statuses an AGV reports in them (``planner.core.status``).
     """
 
     TURNING_IN_PLACE = "turning in place"
-    DRIVING = "driving"
+    DRIVING = status.DRIVING
     RECOVERING = "recovering"
-    WAITING = "waiting"
-    ARRIVED = "arrived"
-    FAILED = "failed"
+    WAITING = status.WAITING
+    ARRIVED = status.ARRIVED
+    FAILED = status.FAILED
 
     @property
     def finished(self) -> bool:
