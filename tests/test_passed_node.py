@@ -38,9 +38,8 @@ def _swerved(profile: str) -> FusionController:
     floor = parse_text_grid("\n".join(["." * 48] * 48), resolution=0.25)
     controller = FusionController(floor, AFTER, FusionConfig(profile=profile))
     controller.start((*BEFORE, math.atan2(NODE[1] - BEFORE[1], NODE[0] - BEFORE[0])))
-    controller.targets = [NODE, AFTER]  # the route R3 had: its node beside the waiting AGV
-    controller.corners = controller._corners_of(BEFORE)
-    controller.target_index = 0
+    # the route R3 had: its node beside the waiting AGV
+    controller.key_nodes.follow([NODE, AFTER], BEFORE, controller.dwa.distance_field)
     controller.step((*BEFORE, 3.07), (0.0, 0.0, 0.0), now=0.0)  # the start's turn ends
     return controller
 
@@ -48,7 +47,7 @@ def _swerved(profile: str) -> FusionController:
 def test_the_controller_goes_on_to_the_next_node_instead_of_turning_back():
     swerved = _swerved("default")
     swerved.step((*BESIDE, 2.7), (0.5, 0.0, 0.0), now=1.0)
-    assert swerved.target_index == 1
+    assert swerved.key_nodes.index == 1
     paper = _swerved(PAPER)
     paper.step((*BESIDE, 2.7), (0.5, 0.0, 0.0), now=1.0)
-    assert paper.target_index == 0  # the paper switches within 1 m only: back to the node
+    assert paper.key_nodes.index == 0  # the paper switches within 1 m only: back to the node

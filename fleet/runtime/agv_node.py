@@ -19,17 +19,13 @@ import numpy as np
 from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
-from planner.core.motion import moving_discs, step_pose, wrap_angle
+from planner.core.motion import moving_discs
 from planner.core.status import FAILED, FINISHED
-from planner.local.keep_right import agv_coming
-from planner.local.lane_speed import oncoming
-from planner.local.no_retreat import retreating
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.nav.fusion import FusionController
-from planner.nav.recovery import towards
-from planner.nav.tight_turns import approach_command, approach_path
-from planner.route.global_planner import PlanResult, warm_up
+from planner.nav.warm_up import warm_up
+from planner.route.global_planner import PlanResult
 from planner.traffic.guard import TrafficGuard
 
 
@@ -65,37 +61,10 @@ class AgvNode:
         self._index = 0  # where this AGV's state was in the last tick's list
 
     def warm_up(self) -> None:
-        """Load (or compile) every numba kernel this node uses, before the run starts.
-
-        It plans this AGV's route once, on the run's map: the costmap's centring and
-        clearance kernels are loaded only by a real route, and an AGV host that forks
-        its AGV processes after this spares each of them loading them again (with 50
-        AGVs on 2 cores, 0.8 s of the start-up). The node is spent: a throwaway."""
-        warm_up()
-        start, goal, dwa = self.spec.start, self.spec.goal, self.controller.dwa
-        pose, rest, cfg = (*start, 0.0), (0.0, 0.0, 0.0), dwa.config
-        self.controller.start(pose)
-        dwa.plan(pose, rest, goal, segment=(start, goal), lane_room=1.0)
-        walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
-        moving_discs(np.array([[*start, 0.0, 0.0, 0.0, 0.0, cfg.radius]] * 2), 0, walker, cfg.dt)
-        dwa.plan(pose, rest, goal, walker)
-        dwa.threatened(pose, walker)
-        dwa.clearance_along(np.array([pose]), walker)  # its map and disc kernels, from Python
-        # what a control cycle calls from Python beyond DWA (each signature is loaded
-        # once per process: in each of 50 forked AGV processes it cost the first ticks)
-        coming = np.array([[*goal, -0.5, 0.0, cfg.radius]])  # an AGV head-on
-        agv_coming(start, (start, goal), cfg.radius, coming)
-        oncoming(pose, (0.5, 0.0, 0.0), coming, cfg.max_accel, cfg.horizon_s)
-        retreating(pose, np.zeros(2), np.zeros(2), goal)
-        approach_path(cfg, pose, rest, goal, cfg.max_speed)
-        approach_command(cfg, pose, rest, goal, cfg.max_speed)
-        step_pose(pose, rest, cfg.dt)
-        towards(cfg, rest, rest)  # the recoveries' commands
-        wrap_angle(0.0)
-        dwa.distance_field.distance_at(*start)
-        dwa.distance_field.distance_at_point(*start)
-        if self.guard is not None:
-            self.guard.passages.first_crossing([start, goal], 1.0)
+        """Load (or compile) every numba kernel this node uses, before the run starts
+        (``planner.nav.warm_up``). The node is spent: a throwaway."""
+        spec = self.spec
+        warm_up(self.scenario.grid, spec.start, spec.goal, spec.config, self.guard)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
         """This AGV's answer to ``tick``; None for a tick that does not list it."""

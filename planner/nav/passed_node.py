@@ -3,9 +3,9 @@
 The fusion controller switches to the next key node within ``reach`` of the current
 one. When DWA keeps the AGV off another body near the node (an AGV waiting beside the
 route, one coming the other way), the AGV can go past the node more than ``reach`` to
-its side; aiming at the node still, it then turns back to it and loops (door n12 s3: an
-AGV out of a 1.0 m door swerved round one waiting beside its route, went by its next
-key node 1.1 m off and circled back to it).
+its side; aiming at the node still, it then turns back to it and loops (an AGV out of
+a 1.0 m door swerved round one waiting beside its route, went by its next key node
+1.1 m off and circled back to it).
 
 The node counts as passed when the AGV is no more than ``reach`` short of it along the
 route's leg into it, no more than ``reach`` short of it along the leg out of it (the

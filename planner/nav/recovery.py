@@ -22,8 +22,15 @@ from planner.local.config import DwaConfig
 from planner.maps.distance_field import DistanceField
 
 RECOVERIES = (REPLAN, WAIT, BACK_OFF, REPLAN, ROTATE, REPLAN)
+"""Cheapest first, a replan after each move (what the move uncovered is planned round), as
+Nav2's recovery subtree clears the costmap before it spins and backs up."""
 DURATION_S = {REPLAN: 0.0, WAIT: 3.0, BACK_OFF: 2.0, ROTATE: 3.0}
-BACK_OFF_SPEED = 0.3  # m/s
+"""s each recovery drives: a wait of a few seconds for a walker or AGV in the way to move
+on; a back-off and a rotation just long enough (a few tenths of a metre, some 60° at the
+default limits) to change what DWA sees, not to wander off the route."""
+BACK_OFF_SPEED = 0.3
+"""m/s: a slow back-off, from a stall in cramped space, reached and braked within a second
+or two at the default acceleration."""
 
 
 @dataclass(frozen=True)
@@ -86,9 +93,9 @@ def off_walls(
     """``direction`` from (x, y), less its part into a wall a body of ``radius`` would press
     against; (0, 0) when nothing is left (a corner).
 
-    Away from a walker that stands on the AGV is often into a wall: nav_bench seed 282's
-    back-off drove 0.3 m into the corner where two wall cells meet. Discs give way or are
-    merely predicted; a wall does not.
+    Away from a walker that stands on the AGV is often into a wall: a back-off from a
+    walker standing on an AGV in a corner drove 0.3 m into the corner where two wall
+    cells meet. Discs give way or are merely predicted; a wall does not.
     """
 
     if not presses_wall(field, x, y, direction, radius):
@@ -138,7 +145,8 @@ def _backing(config: DwaConfig, field: DistanceField, pose: Pose, discs) -> tupl
     and no slower than ``min_vx`` allows. Where that floor cuts off part of the way back,
     what is left must still keep off the walls, or the AGV stands: an AGV that cannot
     reverse and faces a shelf kept only the sideways part of "back along the shelf", and
-    that pressed it into the shelf (traffic suite warehouse-40 n40 s1, agv29)."""
+    that pressed it into the shelf (an AGV stalled nose-on to a shelf in a crowded
+    warehouse aisle)."""
     ux, uy = away_from_obstacles(field, pose, discs, config.radius)
     if not (ux or uy):
         return (0.0, 0.0)

@@ -37,13 +37,16 @@ from planner.nav.recovery import step_towards
 from planner.route.route_check import route_samples
 
 TURN_ON_SPOT = math.radians(10.0)
-"""A tight node turning the route by more than this is a stop and a turn on the spot."""
+"""A tight node turning the route by more than this is a stop and a turn on the spot; a
+smaller turn is driven through (its capped reach keeps the cut within the room)."""
 
 LOOK_AHEAD = 2.0
-"""m: how much of the next stretch counts for the room the body has where it enters."""
+"""m: how much of the next stretch counts for the room the body has where it enters (where
+a cut corner puts it)."""
 
 FACE_FROM = 0.5
-"""m: the straight approach turns the body towards the node until this near it."""
+"""m: the straight approach turns the body towards the node until this near it (nearer,
+the bearing swings fast with every centimetre off the line)."""
 
 FACE_FIRST = math.radians(15.0)
 """rad: a node this far off the heading is faced first, turning on the spot (turning while

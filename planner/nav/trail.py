@@ -3,8 +3,9 @@ past the AGV (``planner.local.yielding``).
 
 A walker keeps to the aisle it walks in, and the aisle behind the AGV is the one the AGV
 drove up: its own tracks, not the plan's key nodes (a replan starts where the AGV
-stands and keeps none of the way before it; in nav_bench's held-out seed 211 the plan
-behind the AGV was 0.5 m long, its tracks 5 m down the aisle the walker came on by).
+stands and keeps none of the way before it: after a replan mid-aisle the plan behind
+the AGV can be half a metre long while its tracks run metres down the aisle the walker
+comes along).
 """
 
 from __future__ import annotations
@@ -15,7 +16,8 @@ from collections import deque
 from planner.maps.grid import Point
 
 TRAIL_STEP = 0.25
-"""m between the positions kept."""
+"""m between the positions kept: a grid cell of the default maps, finer than a walker's way
+needs."""
 
 TRAIL_LENGTH = 20.0
 """m of tracks kept. A walker's way matters where the AGV could stand at the end of a
