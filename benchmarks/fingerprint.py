@@ -33,6 +33,7 @@ from benchmarks.traffic_cases import make_case  # noqa: E402
 from fleet.builtin import builtin_scenarios  # noqa: E402
 from fleet.runtime.inprocess import run_in_process  # noqa: E402
 from fleet.scenario import Scenario, load_scenario, parse_scenario  # noqa: E402
+from planner.core.status import ARRIVED  # noqa: E402
 
 NAV_SEEDS = (3, 8, 12, 40, 42, 211, 282)
 NAV_VARIANTS = (("fusion", "default"), ("fusion", "paper"), ("astar-dwa", "paper"))
@@ -86,7 +87,7 @@ def fingerprint(job: tuple[str, str, tuple]) -> tuple[str, dict]:
     outcome = {
         "sha256": digest.hexdigest(),
         "end": summary.end_reason,
-        "arrived": sum(a.status == "arrived" for a in summary.agvs),
+        "arrived": sum(a.status == ARRIVED for a in summary.agvs),
         "agvs": len(summary.agvs),
         "collisions": summary.collisions,
         "sim_time": round(summary.sim_time, 3),

@@ -46,6 +46,7 @@ from benchmarks.bus_floor import bus_floor_ticks_per_s
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.scenario import load_scenario
+from planner.core.status import ARRIVED
 
 WIDTH, HEIGHT = 60, 40
 PSS_AT_TICK = 100
@@ -233,7 +234,7 @@ def main() -> None:
                 run_in_process(scenario, progress=local)
             floor = bus_floor_ticks_per_s(scenario)
             bus, summary = median_run(scenario, path, args.runs)
-            arrived = sum(a.status == "arrived" for a in summary.agvs)
+            arrived = sum(a.status == ARRIVED for a in summary.agvs)
             local_rate = float("nan") if args.zenoh_only else local.ticks_per_s
             print(
                 f"{size:>5}  {local_rate:>14.1f}  {bus.ticks_per_s:>9.1f}  "

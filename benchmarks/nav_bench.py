@@ -37,6 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from benchmarks.nav_episodes import Episode, episodes, make_episode
 from fleet.runtime.inprocess import run_in_process
+from planner.core.status import ARRIVED, FINISHED
 from recordings.analysis import world_velocity
 
 VARIANTS = (
@@ -49,7 +50,7 @@ VARIANTS = (
 
 def rms_jerk(states, dt: float) -> float:
     """RMS of the world-frame jerk over the drive (up to arrival or failure)."""
-    end = next((i for i, s in enumerate(states) if s.status in ("arrived", "failed")), len(states))
+    end = next((i for i, s in enumerate(states) if s.status in FINISHED), len(states))
     drive = states[: end + 1]
     if len(drive) < 3:
         return 0.0
@@ -91,7 +92,7 @@ def _median(values) -> str:
 def successes(rs: list[dict]) -> tuple[list[dict], int]:
     """The runs that arrived without a collision, and how many runs had a way to arrive by
     (``Episode.way_at_rest``: success is counted where a path exists)."""
-    ok = [r for r in rs if r["way"] and r["status"] == "arrived" and r["collisions"] == 0]
+    ok = [r for r in rs if r["way"] and r["status"] == ARRIVED and r["collisions"] == 0]
     return ok, sum(r["way"] for r in rs)
 
 
@@ -206,9 +207,9 @@ def main() -> None:
             print(f"  seed {e.seed}: no way left once its walkers stopped (not in 'success')")
     shown = [r for r in results if args.seeds or r["variant"] == VARIANTS[0][0]]
     if not args.seeds:  # the whole benchmark: only the default fusion's failures
-        shown = [r for r in shown if r["status"] != "arrived" or r["collisions"]]
+        shown = [r for r in shown if r["status"] != ARRIVED or r["collisions"]]
     for r in shown:
-        arrival = f" at {r['arrival']:.1f} s" if r["status"] == "arrived" else ""
+        arrival = f" at {r['arrival']:.1f} s" if r["status"] == ARRIVED else ""
         print(
             f"  {r['variant']} seed {r['seed']} ({r['vehicle']}, {r['kind']}): {r['status']}"
             f"{arrival}{' ' + r['failure'] if r['failure'] else ''}, "

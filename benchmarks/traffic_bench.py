@@ -39,6 +39,7 @@ from benchmarks.traffic_cases import FAMILIES, TrafficCase, cases, make_case  # 
 from fleet.runtime.inprocess import run_in_process  # noqa: E402
 from fleet.runtime.summary import RunSummary  # noqa: E402
 from fleet.scenario import Scenario  # noqa: E402
+from planner.core.status import ARRIVED, FAILED  # noqa: E402
 
 _SOLO_CACHE: dict[tuple[str, str], dict] = {}
 
@@ -79,7 +80,7 @@ def run_case(family: str, seed: int) -> dict:
     wall = time.perf_counter() - t0
     waits = {a.name: a.waiting_time for a in summary.agvs}
     solos = {a.name: solo_run(case.scenario, a.name) for a in case.scenario.agvs}
-    arrived = sum(a.status == "arrived" for a in summary.agvs)
+    arrived = sum(a.status == ARRIVED for a in summary.agvs)
     everyone = arrived == len(summary.agvs)
     solo_times = [s["time"] for s in solos.values()]
     solo_ok = all(t is not None for t in solo_times)
@@ -155,7 +156,7 @@ def family_rows(results: list[dict]) -> list[dict]:
                 "agvs": agvs,
                 "arrival_pct": 100.0 * sum(r["arrived"] for r in runs) / agvs,
                 "runs_all_arrived": sum(r["arrived"] == r["agvs"] for r in runs),
-                "failed_agvs": sum(s == "failed" for r in runs for s in r["statuses"].values()),
+                "failed_agvs": sum(s == FAILED for r in runs for s in r["statuses"].values()),
                 "runs_with_collision": sum(r["collisions"] > 0 for r in runs),
                 "runs_at_time_limit": sum(r["timed_out"] for r in runs),
                 "median_makespan_over_sum_solo": _median(ratios),
@@ -328,7 +329,7 @@ def main(argv=None) -> None:
                     local = results[(case.family, case.seed)]
                     same = outcome(summary) == local["outcome"]
                     zenoh.append({"case": case.name, "same": same, "outcome": outcome(summary)})
-                    arrived = sum(a.status == "arrived" for a in summary.agvs)
+                    arrived = sum(a.status == ARRIVED for a in summary.agvs)
                     print(
                         f"zenoh {case.name}: {arrived}/{case.agvs} arrived, "
                         f"{summary.collisions} collisions, {summary.end_reason}, "

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import msgspec
 
 from planner.core.errors import BadInputError
-from planner.core.status import RECOVERY_KINDS, STATUSES
+from planner.core.status import DRIVING, RECOVERY_KINDS, STATUSES
 from planner.traffic.zones import PHASES, Intent
 
 # No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
@@ -60,7 +60,7 @@ class AgvState:
     vy: float
     omega: float
     radius: float
-    status: str = "driving"
+    status: str = DRIVING
     target: list[float] | None = None
     plan_time_ms: float = 0.0
     failure: str = ""  # why, when status is "failed"
@@ -82,7 +82,7 @@ class AgvCommand:
     vx: float
     vy: float
     omega: float
-    status: str = "driving"
+    status: str = DRIVING
     target: list[float] | None = None
     plan_time_ms: float = 0.0
     start_heading: float | None = None

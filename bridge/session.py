@@ -28,6 +28,7 @@ LEASE_MS = 1000
 # bytes); a larger one is dropped when it arrives: 50 MB messages cost memory in every node
 MAX_MESSAGE_BYTES = 16 * 1024 * 1024
 CONNECT_ATTEMPT_MS = 500
+CONNECT_TIMEOUT_S = 30.0  # a client gives up when no router answered for this long
 # A client (one AGV) needs one thread per Zenoh runtime: with the default pools,
 # 50 AGV processes on 2 cores spend a third of their CPU on idle runtime threads.
 CLIENT_RUNTIME = (
@@ -146,7 +147,7 @@ def open_router(
 
 def open_client(
     connect: str,
-    timeout: float = 30.0,
+    timeout: float = CONNECT_TIMEOUT_S,
     config_file: str | None = None,
     login: Login | None = None,
 ) -> zenoh.Session:

@@ -28,6 +28,7 @@ from fleet.toml_schema import (
 )
 from planner.core.errors import MapError
 from planner.core.limits import read_input_file
+from planner.core.motion import CONTROL_PERIOD
 from planner.core.profiles import DEFAULT, PROFILES
 from planner.local.config import DwaConfig
 from planner.maps.clearance import ClearanceError, clearance_for
@@ -112,6 +113,16 @@ class Scenario:
     source: str
     path: str
 
+    def __post_init__(self) -> None:
+        # dt is the run's one control period: the world steps by it, each AGV's DWA plans
+        # and checks its window with its own copy, and the two must be the same number
+        for a in self.agvs:
+            if a.config.dwa.dt != self.dt:
+                raise ScenarioError(
+                    f"AGV {a.name!r} plans with a control period of {a.config.dwa.dt:g} s, "
+                    f"but the run steps by dt = {self.dt:g} s: they must be equal"
+                )
+
     def agv(self, name: str) -> AgvSpec:
         spec = self._agvs_by_name.get(name)
         if spec is None:
@@ -157,7 +168,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         raise ScenarioError(f"{where}: not valid TOML: {err}") from None
     check_keys(doc, TOP_KEYS, "")
     name = get_str(doc, "name", "", default=path.stem if path else "scenario")
-    dt = get_number(doc, "dt", "", default=DwaConfig.dt, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
+    dt = get_number(doc, "dt", "", default=CONTROL_PERIOD, minimum=DT_RANGE[0], maximum=DT_RANGE[1])
     profile = get_str(doc, "profile", "", default=DEFAULT, choices=PROFILES)
     grid = _parse_map(get_table(doc, "map", "", required=True), path, name, doc)
     planner_defaults = get_table(doc, "planner", "")

@@ -38,7 +38,7 @@ import numpy as np
 
 from planner.core import path_metrics
 from planner.core.motion import world_velocity
-from planner.core.status import FINISHED, RECOVERY, WAITING
+from planner.core.status import ARRIVED, COLLISION, FINISHED, RECOVERY, REPLAN, WAITING
 from planner.maps.distance_field import DistanceField
 from planner.nav.fusion import GLOBAL_ALGORITHM
 from planner.traffic.zones import DECISIONS, WAIT
@@ -139,7 +139,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
     result = rec.result or {}
     statuses = {a["name"]: a.get("status") for a in result.get("agvs", [])}
     obstacle_gap, agv_gap = _clearances(series)
-    collisions = [e for e in series.events if e.get("kind") == "collision"]
+    collisions = [e for e in series.events if e.get("kind") == COLLISION]
     hits = Counter(n for e in collisions for n in e.get("agvs", []))
     traffic = [e for e in series.events if e.get("kind") in DECISIONS]
     waits = Counter(e["agvs"][0] for e in traffic if e.get("kind") == WAIT and e.get("agvs"))
@@ -165,7 +165,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         dt=dt,
         ticks=int(series.tick[-1]) if len(series.tick) else 0,
         run_time=float(series.time[-1]) if len(series.time) else 0.0,
-        arrived=sum(a.status == "arrived" for a in agvs),
+        arrived=sum(a.status == ARRIVED for a in agvs),
         collisions=len(collisions),
         path_length=_mean(a.path_length for a in agvs),
         distance=_mean(a.distance for a in agvs),
@@ -199,7 +199,7 @@ def _agv(
     time = series.time[rows]
     done = np.flatnonzero(np.isin(status, FINISHED))
     end = int(done[0]) if len(done) else len(rows) - 1
-    arrived = len(done) > 0 and status[end] == "arrived"
+    arrived = len(done) > 0 and status[end] == ARRIVED
     drive = slice(0, end + 1)
     x, y = col["x"], col["y"]
     name = series.agvs.names[i]
@@ -214,7 +214,7 @@ def _agv(
         path_length=None if path is None else path_metrics.path_length(path),
         turns=None if path is None else path_metrics.turning_times(path),
         turning_angle_deg=None if path is None else path_metrics.total_turning_angle_deg(path),
-        replans=sum(p.get("reason") == "replan" for p in series.plans.get(name, [])),
+        replans=sum(p.get("reason") == REPLAN for p in series.plans.get(name, [])),
         **motion,
         min_clearance_obstacles=clearance[0],
         min_clearance_agvs=clearance[1],

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import textwrap
 
+from planner.core.status import ARRIVED
 from recordings.reader import Recording
 
 WIDTH = 100  # columns: long values wrap under their label
@@ -91,7 +92,7 @@ def _ending(rec: Recording) -> str:
         )
         return f"plans only, no simulation: {found}"
     agvs = result.get("agvs", [])
-    success = result.get("collisions", 0) == 0 and all(a.get("status") == "arrived" for a in agvs)
+    success = result.get("collisions", 0) == 0 and all(a.get("status") == ARRIVED for a in agvs)
     return (
         f"{'success' if success else 'failure'}: {result.get('end_reason', '')}, "
         f"{result.get('collisions', 0)} collisions, {result.get('sim_time', 0):.1f} s simulated"

@@ -9,25 +9,17 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
 
 from planner.core.motion import world_velocity
 from planner.maps.grid import GridMap
 from recordings.plan_metrics import MapPlans
+from recordings.plots import draw_map, draw_temporary_cells, save_figure
 from recordings.series import RunSeries
 
 DPI = 80
 PLAN_STYLE = {"traditional": ("tab:red", "--"), "improved": ("tab:blue", "-")}
 ALGORITHM_COLOUR = {"fusion": "tab:blue", "astar-dwa": "tab:red", "dwa": "tab:green"}
-
-
-def _save(figure: Figure, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
-    return path
 
 
 def _panels(count: int, columns: int, size: float = 3.0):
@@ -43,14 +35,7 @@ def _panels(count: int, columns: int, size: float = 3.0):
 def _draw_map(ax, grid: GridMap | None) -> None:
     if grid is None:
         return
-    x0, x1, y0, y1 = grid.extent
-    ax.imshow(
-        grid.blocked, origin="lower", extent=(x0, x1, y0, y1), cmap="Greys",
-        vmin=0, vmax=1.4, interpolation="nearest",
-    )  # fmt: skip
-    ax.set_xlim(x0, x1)
-    ax.set_ylim(y0, y1)
-    ax.set_aspect("equal")
+    draw_map(ax, grid)
     ax.tick_params(labelsize="x-small")
 
 
@@ -72,7 +57,7 @@ def plans_figure(
         ax.set_title(title, fontsize="small")
     axes[0].legend(fontsize="x-small", loc="lower right")
     figure.tight_layout()
-    return _save(figure, path)
+    return save_figure(figure, path, DPI)
 
 
 def spread_figure(values: dict[str, dict[str, list[float]]], labels: dict[str, str], path: Path):
@@ -87,18 +72,7 @@ def spread_figure(values: dict[str, dict[str, list[float]]], labels: dict[str, s
         ax.tick_params(labelsize="x-small")
         ax.grid(True, axis="y", lw=0.4, alpha=0.6)
     figure.tight_layout()
-    return _save(figure, path)
-
-
-def _temporary_cells(ax, series: RunSeries) -> None:
-    if series.grid is None:
-        return
-    grid = series.grid
-    res = grid.resolution
-    for col, row in sorted({c for shown in series.temporary for c in shown}):
-        cx, cy = grid.centre_of((col, row))
-        corner = (cx - res / 2, cy - res / 2)
-        ax.add_patch(Rectangle(corner, res, res, color="tab:orange", alpha=0.8))
+    return save_figure(figure, path, DPI)
 
 
 def trajectories_figure(
@@ -109,7 +83,7 @@ def trajectories_figure(
     figure, axes = _panels(len(runs), columns, size=3.4)
     for ax, series, title in zip(axes, runs, titles, strict=True):
         _draw_map(ax, series.grid)
-        _temporary_cells(ax, series)
+        draw_temporary_cells(ax, series)
         mov = series.moving.columns
         for m in range(len(series.moving.names)):
             ax.plot(mov["x"][:, m], mov["y"][:, m], color="tab:gray", lw=1.0, ls="--")
@@ -126,7 +100,7 @@ def trajectories_figure(
                 ax.plot(x[0], y[0], "^", color="tab:blue", ms=6)
         ax.set_title(title, fontsize="small")
     figure.tight_layout()
-    return _save(figure, path)
+    return save_figure(figure, path, DPI)
 
 
 def velocity_figure(runs: Sequence[RunSeries], labels: Sequence[str], path: Path) -> Path:
@@ -149,4 +123,4 @@ def velocity_figure(runs: Sequence[RunSeries], labels: Sequence[str], path: Path
         ax.grid(True, lw=0.4, alpha=0.6)
         ax.legend(fontsize="x-small", loc="upper right")
     figure.tight_layout()
-    return _save(figure, path)
+    return save_figure(figure, path, DPI)

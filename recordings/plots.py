@@ -14,6 +14,7 @@ from matplotlib.patheffects import withStroke
 
 from planner.core.motion import world_velocity
 from planner.core.path_metrics import crossing_points
+from planner.maps.grid import GridMap
 from recordings.series import RunSeries
 
 DPI = 100
@@ -24,17 +25,31 @@ def save_plots(series: RunSeries, out_dir: Path, stem: str, label: str) -> list[
     """Write ``<stem>-map.png`` and ``<stem>-velocity-<agv>.png`` into ``out_dir``,
     titled with ``label`` (scenario and algorithm: which run it is)."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    paths = [_save(map_figure(series, label), out_dir / f"{stem}-map.png")]
+    paths = [save_figure(map_figure(series, label), out_dir / f"{stem}-map.png", DPI)]
     for i, name in enumerate(series.agvs.names):
         figure = _velocity_figure(series, i, label)
-        paths.append(_save(figure, out_dir / f"{stem}-velocity-{name}.png"))
+        paths.append(save_figure(figure, out_dir / f"{stem}-velocity-{name}.png", DPI))
     return paths
 
 
-def _save(figure: Figure, path: Path) -> Path:
+def save_figure(figure: Figure, path: Path, dpi: int) -> Path:
+    """``figure`` as an optimised PNG at ``path`` (its folder made if missing)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
+    figure.savefig(path, dpi=dpi, pil_kwargs={"optimize": True})
     return path
+
+
+def draw_map(ax, grid: GridMap) -> None:
+    """The map's obstacle cells in grey, the axes fitted to the map at equal scale."""
+    x0, x1, y0, y1 = grid.extent
+    ax.imshow(
+        grid.blocked, origin="lower", extent=(x0, x1, y0, y1), cmap="Greys",
+        vmin=0, vmax=1.4, interpolation="nearest",
+    )  # fmt: skip
+    ax.set_xlim(x0, x1)
+    ax.set_ylim(y0, y1)
+    ax.set_aspect("equal")
 
 
 def map_figure(series: RunSeries, label: str) -> Figure:
@@ -47,11 +62,8 @@ def map_figure(series: RunSeries, label: str) -> Figure:
     figure = Figure(figsize=(max(4.0, width * scale) + 2.5, max(3.0, height * scale) + 0.8))
     ax = figure.add_subplot()
     if grid is not None:
-        ax.imshow(
-            grid.blocked, origin="lower", extent=(x0, x1, y0, y1), cmap="Greys",
-            vmin=0, vmax=1.4, interpolation="nearest",
-        )  # fmt: skip
-        _temporary_cells(ax, series)
+        draw_map(ax, grid)
+        draw_temporary_cells(ax, series)
     mov = series.moving.columns
     for m in range(len(series.moving.names)):
         ax.plot(mov["x"][:, m], mov["y"][:, m], color="tab:gray", lw=0.8, ls="--")
@@ -90,9 +102,11 @@ def map_figure(series: RunSeries, label: str) -> Figure:
     return figure
 
 
-def _temporary_cells(ax, series: RunSeries) -> None:
+def draw_temporary_cells(ax, series: RunSeries) -> None:
     """Every temporary obstacle cell shown during the run, as orange squares."""
     grid = series.grid
+    if grid is None:
+        return
     res = grid.resolution
     for col, row in sorted({c for shown in series.temporary for c in shown}):
         cx, cy = grid.centre_of((col, row))

@@ -15,10 +15,10 @@ import numpy as np
 import rerun as rr
 
 from bridge import keys
+from planner.core.motion import CONTROL_PERIOD
 from recordings.rerun_blueprint import blueprint
 from recordings.rerun_rows import TIMELINE, Row, RowMaker
 
-DEFAULT_DT = 0.1  # the paper's control period, for a recording cut before its second tick
 LIVE_PERIOD = 0.1  # s of wall time between sends of a live view
 
 
@@ -27,7 +27,7 @@ def recording_dt(messages) -> float:
     for m in messages:
         if m.topic == keys.WORLD_TICK and m.data["tick"] > 0:
             return m.data["time"] / m.data["tick"]
-    return DEFAULT_DT
+    return CONTROL_PERIOD  # a recording cut before its second tick: the default period
 
 
 class Columns:

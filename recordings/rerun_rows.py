@@ -45,7 +45,7 @@ import rerun as rr
 
 from bridge import keys
 from bridge.messages import MessageError
-from planner.core.status import FINISHED, RECOVERY
+from planner.core.status import COLLISION, FAILED, FINISHED, INITIAL, RECOVERY, REPLAN
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.traffic.passages import NONE, Passages
@@ -68,7 +68,8 @@ QUANTITIES = ("vx", "vy", "speed", "omega")
 
 WHITE, GREY, ORANGE, DARK = (230, 230, 230), (160, 160, 160), (255, 160, 0), (20, 20, 20)
 FREE_SHADE, BLOCKED_SHADE = 225, 70  # grey levels of the map image
-LEVELS = {"collision": "WARN", "failed": "ERROR", "no path": "WARN", RECOVERY: "WARN"}
+NO_PATH = "no path"  # the kind of event a plan that found no path shows as
+LEVELS = {COLLISION: "WARN", FAILED: "ERROR", NO_PATH: "WARN", RECOVERY: "WARN"}
 WAITING_RING = 1.6  # x radius: the ring shows round the body
 HEADING_LENGTH = 2.0  # x radius: the heading line sticks out of the disc, visible when small
 LABEL_GAP = 1.0  # m right of the disc's rim: the name (centred on its anchor) never covers it
@@ -301,12 +302,12 @@ class RowMaker:
             self._goal_shown.add(name)
             rows.append(_goal(name, path[-1]))
         if not data["found"]:
-            self._log_event(t, "no path", [name], data["reason"], rows)
-        elif data["reason"] != "initial":
+            self._log_event(t, NO_PATH, [name], data["reason"], rows)
+        elif data["reason"] != INITIAL:
             detail = f"new path {data['length']:.1f} m"
-            if data["reason"] != "replan":
+            if data["reason"] != REPLAN:
                 detail = f"{data['reason']}, {detail}"
-            self._log_event(t, "replan", [name], detail, rows)
+            self._log_event(t, REPLAN, [name], detail, rows)
 
     def _trajectory(self, name: str, data: dict, rows: list[Row]) -> None:
         self._dwa_shown.add(name)

@@ -14,7 +14,14 @@ import sys
 from pathlib import Path
 
 from bridge.bus import Bus
-from bridge.session import Guard, Login, has_authentication, open_client, open_router
+from bridge.session import (
+    CONNECT_TIMEOUT_S,
+    Guard,
+    Login,
+    has_authentication,
+    open_client,
+    open_router,
+)
 from bridge.trust import (
     CREDENTIALS_ENV,
     RECORDER_USER,
@@ -29,7 +36,7 @@ from fleet.runtime.agv_host import serve_agvs
 from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
-from fleet.runtime.world_server import START_TIMEOUT_S, WorldServer
+from fleet.runtime.world_server import START_TIMEOUT_S, TICK_TIMEOUT_S, WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S, WorldGone
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.core.profiles import PROFILES
@@ -83,7 +90,7 @@ def add_parsers(sub) -> None:
         help="Zenoh endpoint to listen on, e.g. tcp/127.0.0.1:7447",
     )
     w.add_argument("--realtime", type=positive_float, metavar="F")
-    w.add_argument("--tick-timeout", type=positive_float, default=2.0, metavar="S")
+    w.add_argument("--tick-timeout", type=positive_float, default=TICK_TIMEOUT_S, metavar="S")
     w.add_argument(
         "--start-timeout",
         type=positive_float,
@@ -111,9 +118,9 @@ def add_parsers(sub) -> None:
     a.add_argument(
         "--connect-timeout",
         type=positive_float,
-        default=30.0,
+        default=CONNECT_TIMEOUT_S,
         metavar="S",
-        help="give up when no router answers within S seconds (default 30)",
+        help=f"give up when no router answers within S seconds (default {CONNECT_TIMEOUT_S:g})",
     )
     a.set_defaults(handler=run_agv)
 
@@ -129,7 +136,7 @@ def add_parsers(sub) -> None:
     r.add_argument("--connect", required=True, metavar="ENDPOINT")
     r.add_argument("-o", "--output", metavar="PATH", help="default: runs/<scenario>-<UTC>.mcap")
     r.add_argument("--run-id", help="stored in the recording's run facts")
-    r.add_argument("--connect-timeout", type=positive_float, default=30.0, metavar="S")
+    r.add_argument("--connect-timeout", type=positive_float, default=CONNECT_TIMEOUT_S, metavar="S")
     r.set_defaults(handler=run_record)
 
 

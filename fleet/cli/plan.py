@@ -45,7 +45,7 @@ def add_parser(sub) -> None:
         ),
     )
     p.add_argument(
-        "--radius", type=float, default=DEFAULT_RADIUS, help="AGV radius, m (default 0.3)"
+        "--radius", type=float, default=DEFAULT_RADIUS, help="AGV radius, m (default %(default)s)"
     )
     p.add_argument(
         "--margin",

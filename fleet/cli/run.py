@@ -17,6 +17,7 @@ from fleet.runtime.launcher import FleetOptions, RecordingLost, run_fleet
 from fleet.runtime.progress import Progress
 from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
+from fleet.runtime.world_server import TICK_TIMEOUT_S
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import load_scenario, with_algorithm, with_profile
 from planner.core.profiles import PROFILES
@@ -78,9 +79,12 @@ def add_parsers(sub) -> None:
     p.add_argument(
         "--tick-timeout",
         type=positive_float,
-        default=2.0,
+        default=TICK_TIMEOUT_S,
         metavar="S",
-        help="an AGV that does not answer a tick within S seconds is lost (default 2)",
+        help=(
+            "an AGV that does not answer a tick within S seconds is lost "
+            f"(default {TICK_TIMEOUT_S:g})"
+        ),
     )
     p.add_argument(
         "--grace",

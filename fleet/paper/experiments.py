@@ -36,6 +36,7 @@ from fleet.runtime.inprocess import run_recorded
 from fleet.runtime.world import map_message
 from fleet.scenario import Scenario, load_scenario, with_algorithm, with_profile
 from planner.core.profiles import DEFAULT, PAPER
+from planner.core.status import INITIAL
 from planner.maps.grid import GridMap
 from planner.maps.random_map import random_map
 from planner.maps.text_maps import load_matrix_text
@@ -167,7 +168,7 @@ def record_plans(
         found = {}
         for algorithm in PLAN_ALGORITHMS:
             plan = plan_global(grid, start, goal, algorithm, profile=profile)
-            writer.write(agv_plan(algorithm), plan_message(algorithm, None, plan, "initial"), 0)
+            writer.write(agv_plan(algorithm), plan_message(algorithm, None, plan, INITIAL), 0)
             found[algorithm] = plan.found
         writer.finish({"found": found})
 

@@ -20,7 +20,7 @@ from setproctitle import setproctitle
 
 from bridge.bus import Bus
 from bridge.log import say
-from bridge.session import Login, open_client
+from bridge.session import CONNECT_TIMEOUT_S, Login, open_client
 from fleet import exit_codes
 from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.agv_process import serve_agv
@@ -37,7 +37,7 @@ def serve_agvs(
     connect: str,
     prefix: str,
     *,
-    connect_timeout: float = 30.0,
+    connect_timeout: float = CONNECT_TIMEOUT_S,
     zenoh_config: str | None = None,
     logins: dict[str, Login] | None = None,
     grace: float = DEFAULT_GRACE_S,

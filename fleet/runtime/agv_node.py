@@ -20,7 +20,7 @@ from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import Scenario
 from planner.core.motion import moving_discs
-from planner.core.status import FAILED, FINISHED
+from planner.core.status import FAILED, FINISHED, INITIAL, REPLAN, TRAFFIC
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.nav.fusion import FusionController
@@ -79,7 +79,7 @@ class AgvNode:
         if not self._started:
             self._started = True
             pose, plan = self.controller.start(pose)
-            plan_msg = self._plan_msg(tick, plan, "initial")
+            plan_msg = self._plan_msg(tick, plan, INITIAL)
             if pose[2] != me.theta:
                 start_heading = float(pose[2])
         self._sense(tick, pose)
@@ -92,7 +92,7 @@ class AgvNode:
                 self.name, tick.tick, (me.x, me.y), route, tick.intents, stalled
             )
             if decision.rejoin:  # it waited off its route: plan the way in from here
-                plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), "traffic")
+                plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), TRAFFIC)
                 self.guard.replanned()
         walkers = _walkers(tick)
         step = self.controller.step(
@@ -100,7 +100,7 @@ class AgvNode:
             hold=decision.hold if decision else None,
         )  # fmt: skip
         if step.plan is not None:
-            plan_msg = self._plan_msg(tick, step.plan, "replan")
+            plan_msg = self._plan_msg(tick, step.plan, REPLAN)
             if self.guard is not None:
                 self.guard.replanned()
         command = self._command(tick, step.command, step.status, step.target)

@@ -32,7 +32,7 @@ from bridge.trust import CREDENTIALS_ENV, write_run_credentials
 from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.summary import RunSummary
 from fleet.runtime.world import World
-from fleet.runtime.world_server import WorldServer
+from fleet.runtime.world_server import TICK_TIMEOUT_S, WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
 from fleet.scenario import Scenario
 from planner.core.errors import EnvironmentFailure
@@ -49,7 +49,7 @@ class FleetOptions:
     realtime: float | None = None
     transport: str = "unix"
     zenoh_config: str | None = None
-    tick_timeout: float = 2.0
+    tick_timeout: float = TICK_TIMEOUT_S
     grace: float = DEFAULT_GRACE_S
     record_path: Path | None = None  # None: no recorder
     say_waiting: bool = False  # tell on stderr when the AGVs are slow to come up

@@ -7,6 +7,7 @@ import time
 
 from fleet.runtime.world import World
 from fleet.scenario import Scenario
+from planner.core.status import ARRIVED, FAILED
 
 
 class Progress:
@@ -24,8 +25,8 @@ class Progress:
         if now - self._last < self.interval and not world.ended:
             return
         self._last = now
-        arrived = sum(r.status == "arrived" for r in world.records.values())
-        failed = sum(r.status == "failed" for r in world.records.values())
+        arrived = sum(r.status == ARRIVED for r in world.records.values())
+        failed = sum(r.status == FAILED for r in world.records.values())
         line = (
             f"t={world.time:7.1f}/{self.scenario.time_limit:g} s  tick {world.tick}  "
             f"arrived {arrived}/{len(world.records)}"

@@ -20,7 +20,18 @@ from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
 from planner.core.motion import limit_command, step_pose
 from planner.core.profiles import PAPER
-from planner.core.status import ARRIVED, DRIVING, FAILED, FINISHED, RECOVERY, WAITING
+from planner.core.status import (
+    ARRIVED,
+    CLIPPED,
+    COLLISION,
+    DRIVING,
+    END,
+    FAILED,
+    FINISHED,
+    RECOVERY,
+    REFUSED,
+    WAITING,
+)
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import GridMap
 from planner.traffic.guard import ROUTE_POINTS
@@ -34,7 +45,7 @@ class AgvRecord:
     """What the world keeps of one AGV for the summary."""
 
     name: str
-    status: str = "driving"
+    status: str = DRIVING
     arrival_time: float | None = None
     distance: float = 0.0
     collisions: int = 0
@@ -87,7 +98,7 @@ class World:
     def live_agvs(self) -> list[str]:
         """AGVs whose answer the next tick waits for: all but the failed ones (an
         arrived AGV keeps answering, parked, so every tick has every AGV's state)."""
-        return [n for n, r in self.records.items() if r.status != "failed"]
+        return [n for n, r in self.records.items() if r.status != FAILED]
 
     def _running(self) -> list[str]:
         return [n for n, r in self.records.items() if r.status not in FINISHED]
@@ -138,7 +149,7 @@ class World:
                 record.clipped += 1
                 if record.clipped == 1:
                     self.events.append(
-                        Event(self.tick, self.time, "clipped", [name], _limits_note(requested))
+                        Event(self.tick, self.time, CLIPPED, [name], _limits_note(requested))
                     )
         x, y, theta = step_pose(pose, velocity, self.dt)
         record.distance += math.hypot(x - old.x, y - old.y)
@@ -183,7 +194,7 @@ class World:
         record = self.records[name]
         record.refused += 1
         if record.refused == 1:
-            self.events.append(Event(self.tick, self.time, "refused", [name], what))
+            self.events.append(Event(self.tick, self.time, REFUSED, [name], what))
 
     def _done_reason(self) -> str:
         failed = sum(r.status == FAILED for r in self.records.values())
@@ -220,7 +231,7 @@ class World:
     def _finish(self, name: str, status: str, why: str) -> None:
         record = self.records[name]
         record.status = status
-        if status == "arrived":
+        if status == ARRIVED:
             record.arrival_time = self.time
         else:
             record.failure = why
@@ -229,7 +240,7 @@ class World:
     def _end(self, reason: str) -> None:
         self.ended = True
         self.end_reason = reason
-        self.events.append(Event(self.tick, self.time, "end", [], reason))
+        self.events.append(Event(self.tick, self.time, END, [], reason))
 
     def _make_tick(self) -> Tick:
         return Tick(
@@ -300,7 +311,7 @@ class World:
             for n in involved:
                 self.records[n].collisions += 1
             self.events.append(
-                Event(self.tick, self.time, "collision", involved, " and ".join(sorted(pair)))
+                Event(self.tick, self.time, COLLISION, involved, " and ".join(sorted(pair)))
             )
         self._contacts = contacts
 

@@ -37,6 +37,7 @@ START_TIMEOUT_S = 120.0
 compiles every numba kernel in the AGV host before its AGVs come up: about 55 s on a
 2-core machine since the control cycle is compiled (37 s before). 30 s, then 60 s, came
 too close to that."""
+TICK_TIMEOUT_S = 2.0  # an AGV that does not answer a tick within this is lost
 SAY_WAITING_AFTER_S = 3.0  # a wait this long for the AGVs is said (``say_waiting``)
 
 
@@ -50,7 +51,7 @@ class WorldServer:
         scenario: Scenario,
         bus: Bus,
         *,
-        tick_timeout: float = 2.0,
+        tick_timeout: float = TICK_TIMEOUT_S,
         grace: float = DEFAULT_GRACE_S,
         start_timeout: float = START_TIMEOUT_S,
         realtime: float | None = None,

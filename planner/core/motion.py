@@ -14,6 +14,11 @@ Pose = tuple[float, float, float]
 Command = tuple[float, float, float]
 """vx, vy (m/s, body frame), omega (rad/s)."""
 
+CONTROL_PERIOD = 0.1
+"""s, the paper's control period (section 5): a scenario's ``dt`` when it gives none. A
+run has one period, the scenario's: the world steps by it and every AGV's DwaConfig
+carries it (``fleet.scenario.Scenario`` refuses one that disagrees)."""
+
 
 @numba.njit(cache=True)
 def step_pose(pose: Pose, command: Command, dt: float) -> Pose:

@@ -1,4 +1,9 @@
-"""What an AGV reports each tick, and which of those statuses end its run."""
+"""The words of a run's record: what an AGV reports each tick, which of those end its run,
+why a plan was made, and the kinds of the world's events.
+
+They are strings of the recording and of ``--json`` (a public contract): name them from
+here, never spell them again.
+"""
 
 from __future__ import annotations
 
@@ -14,3 +19,14 @@ FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run
 # one, and the kind of the world's event for that
 REPLAN, WAIT, BACK_OFF, ROTATE = RECOVERY_KINDS = ("replan", "wait", "back off", "rotate")
 RECOVERY = "recovery"
+
+# why an AGV sent a plan (PlanMsg.reason): its first, a replan of its controller (REPLAN),
+# or the way back onto its route after waiting off it for the traffic rule
+INITIAL = "initial"
+TRAFFIC = "traffic"
+
+# the world's other events (an AGV's end is an event of its status, ARRIVED or FAILED)
+CLIPPED = "clipped"  # a command beyond the AGV's limits, clipped
+REFUSED = "refused"  # a report the world did not believe
+COLLISION = "collision"
+END = "end"

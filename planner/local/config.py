@@ -7,6 +7,9 @@ import math
 import numbers
 from dataclasses import dataclass, fields
 
+from planner.core.motion import CONTROL_PERIOD
+from planner.maps.clearance import CLEARANCE_CAP, DEFAULT_RADIUS
+
 _EPS = 1e-9
 
 
@@ -21,13 +24,13 @@ class DwaConfig:
     max_alpha: float = math.radians(50.0)  # rad/s², angular acceleration
     v_resolution: float = 0.01  # m/s
     omega_resolution: float = math.radians(1.0)  # rad/s
-    dt: float = 0.1  # s, control period and rollout step
+    dt: float = CONTROL_PERIOD  # s, control period and rollout step: the scenario's
     predict_time: float = 3.0  # s, rollout horizon
     alpha: float = 0.1  # weight of xhead
     beta: float = 0.2  # weight of dist
     gamma: float = 0.2  # weight of vel
-    radius: float = 0.3  # m, AGV disc radius
-    clearance_cap: float = 2.0  # m, largest clearance credited by the dist term
+    radius: float = DEFAULT_RADIUS  # m, AGV disc radius
+    clearance_cap: float = CLEARANCE_CAP  # m, largest clearance credited by the dist term
 
     def __post_init__(self) -> None:
         for f in fields(self):

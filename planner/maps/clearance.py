@@ -23,6 +23,9 @@ DEFAULT_RADIUS = 0.3
 """m, the AGV of the paper's Table 1."""
 DEFAULT_MARGIN = 0.2
 """m, kept beyond the radius where there is room (radius + margin = the paper's 0.5 m)."""
+CLEARANCE_CAP = 2.0
+"""m, the most clearance that counts: DWA's dist term credits no more (farther from every
+obstacle is no safer), and a route's clearance is measured up to it."""
 
 
 class ClearanceError(BadInputError, ValueError):

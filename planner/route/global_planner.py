@@ -25,7 +25,7 @@ import numpy as np
 
 from planner.core.path_metrics import path_length, total_turning_angle_deg, turning_times
 from planner.core.profiles import DEFAULT, PAPER, check_profile
-from planner.maps.clearance import Clearance, clearance_for
+from planner.maps.clearance import CLEARANCE_CAP, Clearance, clearance_for
 from planner.maps.costmap import Costmap
 from planner.maps.grid import Cell, GridMap, Point
 from planner.maps.segment_clearance import route_clearance
@@ -40,10 +40,8 @@ from planner.route.key_nodes import (
 
 ALGORITHMS = ("traditional", "improved")
 
-# AGV radius 0.3 m (Table-1-sized AGV) plus a 0.2 m margin
+# the default radius plus the default margin (planner.maps.clearance)
 DEFAULT_SAFETY_DISTANCE = Clearance().safety_distance
-CLEARANCE_CAP = 2.0
-"""m: a route's clearance is measured up to this (``PlanResult.clearance``)."""
 
 
 @dataclass(frozen=True)

@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 from planner.core.path_metrics import distance_to_path
+from planner.core.physics import braking_distance
 from planner.local.config import DwaConfig
 from planner.maps.costmap import Costmap
 from planner.maps.grid import Point
@@ -74,7 +75,7 @@ class TrafficGuard:
         self.costmap = costmap
         self.passages = Passages.for_costmap(costmap)
         safety = costmap.clearance.safety_distance
-        braking = dwa.max_speed**2 / (2 * dwa.max_accel)
+        braking = braking_distance(dwa.max_speed, dwa.max_accel)
         self.request_distance = braking + (max(WAIT_BACK) + 2) * safety
         self.stop_distance = braking + WAIT_BACK[0] * safety  # closer: stop before asking
         self.release_distance = WAIT_BACK[0] * safety
@@ -201,15 +202,16 @@ class TrafficGuard:
         the AGV waits or is let in. A waiting place down a queue or after a yield can lie
         beyond the request distance, and so can the passage on the route planned from it
         when the AGV is let in; dropping the claim there sent the AGV on towards the
-        passage unclaimed, to ask again last (door n12 s3: the worst AGV drove 2.61 times
-        its route, looping through the right-hand room)."""
+        passage unclaimed, to ask again last (in a crowd at a one-AGV door, an AGV drove
+        2.6 times its route, looping through the room it waited in)."""
         return self.request_distance * (2.0 if self._phase in (WAIT, YIELD, GO) else 1.0)
 
     def _taken(self, me: Intent, intents: list[Intent]) -> bool:
         """Whether an AGV held before this one (``since``, then name) waits at a place within
         a safety distance of this one's. Two AGVs that ask in the same tick choose their
         places without seeing each other's; the later one chooses again, the earlier one
-        keeps its place (door n12 s3: R5 circled the place R4 stood on for 10 s)."""
+        keeps its place (two AGVs that asked together at a door chose one place, and the
+        later one circled the other standing on it for 10 s)."""
         before = self._discs(
             i for i in intents
             if i.phase in HELD and i.hold and (i.since, i.name) < (me.since, me.name)
@@ -223,8 +225,8 @@ class TrafficGuard:
 
     def _clear_way(self, position: Point, place: Point) -> bool:
         """Whether the straight way from ``position`` to ``place`` passes no waiting AGV
-        by less than both radii and half a safety distance (door n12 s3: R1, moving up
-        the queue, drove round R2 waiting between it and its new place: a loop)."""
+        by less than both radii and half a safety distance (an AGV moving up a queue
+        drove round one waiting between it and its new place: a loop)."""
         margin = self.costmap.clearance.radius + self.costmap.clearance.safety_distance / 2
         return all(
             distance_to_path([position, place], (x, y)) >= r + margin for x, y, r in self._waiting
@@ -233,8 +235,8 @@ class TrafficGuard:
     def _in_way_of(self, stuck: list[Intent], position: Point) -> bool:
         """Whether this AGV, or its waiting place, is ``IN_WAY`` of the way ahead of a stuck
         holder: only then does it yield further back. Every waiting AGV
-        yielding for any stuck holder churned the crowd at a 1.0 m door (door n12 s3:
-        waiting AGVs looped through the rooms, up to 3.7 times their routes)."""
+        yielding for any stuck holder churned the crowd at a 1.0 m door (the waiting
+        AGVs looped through the rooms, up to 3.7 times their routes)."""
         reach = IN_WAY * self.costmap.clearance.safety_distance
         places = [position] if self._hold is None else [position, self._hold]
         return any(
