@@ -14,6 +14,7 @@ from pathlib import Path
 
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError
+from fleet.runtime.interrupts import interrupts_raised
 from fleet.sweep.folder import sweep_entry, write_manifest
 from fleet.sweep.grid import build_grid
 from fleet.sweep.keys import parse_vary
@@ -115,7 +116,16 @@ def run_sweep(args: argparse.Namespace) -> int:
         )
         progress(done)
 
-    every = execute_sweep(runs, out, executor, finished)
+    try:
+        with interrupts_raised():  # SIGTERM too: the pool is stopped, not orphaned
+            every = execute_sweep(runs, out, executor, finished)
+    except KeyboardInterrupt:
+        print(
+            f"agv-fleet sweep: {progress.done} of {len(runs)} runs recorded in {out}; "
+            "the same command goes on from there",
+            file=sys.stderr,
+        )
+        raise
     entries = [measured[f.recording] for f in every]  # in the grid's order
     print_sweep(args, entries, [v.key for v in over], out)
     return exit_codes.OK
