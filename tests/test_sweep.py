@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 import tomlkit
 
+from benchmarks.dask_processes import DaskProcesses
 from fleet.sweep.grid import build_grid, variant_scenario
 from fleet.sweep.keys import SweepKeyError, apply, parse_vary, split_values
 from recordings.reader import open_recording
@@ -207,7 +208,7 @@ def test_local_and_dask_sweeps_agree_and_a_resumed_sweep_redoes_nothing(tiny, tm
     )
     assert "4/4 done" in local.stderr
 
-    with dask_cluster(tmp_path) as address:
+    with DaskProcesses(tmp_path, workers=2) as address:
         remote = sweep(str(tiny), *GRID_2X2, "--cluster", address, "--out", str(dask_out), "--json")
     assert remote.returncode == 0, remote.stderr
     remote_report = json.loads(remote.stdout)
@@ -231,49 +232,6 @@ def test_local_and_dask_sweeps_agree_and_a_resumed_sweep_redoes_nothing(tiny, tm
     )
     assert analysed.returncode == 0, analysed.stderr
     assert json.loads(analysed.stdout)["variants"] == report["variants"]
-
-
-class dask_cluster:
-    """A real ``dask scheduler`` and ``dask worker`` (two processes) on free 127.0.0.1
-    ports, started as subprocesses and always stopped."""
-
-    def __init__(self, folder: Path):
-        self.file = folder / "scheduler.json"
-        self.folder = folder
-        self.processes: list[subprocess.Popen] = []
-
-    def __enter__(self) -> str:
-        from distributed import Client
-
-        common = ["--no-dashboard", "--scheduler-file", str(self.file)]
-        self._start("scheduler", "--host", "127.0.0.1", "--port", "0", *common)
-        try:
-            deadline = time.monotonic() + 60
-            while not self.file.is_file() and time.monotonic() < deadline:
-                time.sleep(0.2)
-            address = json.loads(self.file.read_text())["address"]
-            self._start("worker", "--nworkers", "2", "--nthreads", "1", *common)
-            with Client(address, timeout=30) as client:
-                client.wait_for_workers(2, timeout=60)
-            return address
-        except BaseException:
-            self.__exit__()
-            raise
-
-    def _start(self, role: str, *args: str) -> None:
-        log = (self.folder / f"dask-{role}.log").open("w")
-        self.processes.append(
-            subprocess.Popen([str(BIN / "dask"), role, *args], stdout=log, stderr=log)
-        )
-
-    def __exit__(self, *exc) -> None:
-        for process in reversed(self.processes):  # the workers first, then the scheduler
-            process.terminate()
-            try:
-                process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait()
 
 
 def test_ctrl_c_keeps_the_finished_runs_and_the_next_sweep_makes_only_the_rest(tiny, tmp_path):
