@@ -67,8 +67,8 @@ def _legend_below(figure: Figure, axes) -> None:
             list(entries.values()), list(entries), loc="lower center",
             ncol=min(len(entries), 3), fontsize="small", frameon=False,
         )  # fmt: skip
-        rows = math.ceil(len(entries) / 3)
-        figure.tight_layout(rect=(0, min(0.4, 0.06 * rows * 3.4 / figure.get_figheight()), 1, 1))
+        lines = math.ceil(len(entries) / 3)  # a legend line is about 0.25 in high
+        figure.tight_layout(rect=(0, min(0.4, (0.25 * lines + 0.2) / figure.get_figheight()), 1, 1))
     else:
         figure.tight_layout()
 

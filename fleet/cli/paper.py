@@ -71,6 +71,7 @@ def run_paper(args: argparse.Namespace) -> int:
     # imported here: matplotlib and the experiment code are only needed by this command
     from fleet.paper.experiments import DEFAULT_MAPS50, QUICK_MAPS50, run_experiments
     from fleet.paper.report import write_report
+    from fleet.runtime.interrupts import interrupts_raised
 
     maps50 = args.maps50 or (QUICK_MAPS50 if args.quick else DEFAULT_MAPS50)
     t0 = time.perf_counter()
@@ -81,7 +82,8 @@ def run_paper(args: argparse.Namespace) -> int:
 
     runs = Path(args.runs) if args.runs else Path(args.out) / RUNS_IN_OUT
     workers = args.workers or os.cpu_count() or 1
-    results = run_experiments(runs, maps50, log, workers, quick=args.quick)
+    with interrupts_raised():  # SIGTERM too: the sweep's pool is stopped, not orphaned
+        results = run_experiments(runs, maps50, log, workers, quick=args.quick)
     t1 = time.perf_counter()
     path = write_report(results, Path(args.out))
     results.timings["report"] = time.perf_counter() - t1
