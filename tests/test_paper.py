@@ -28,9 +28,9 @@ EXPERIMENTS = ("Table 2", "Table 3", "Fig. 8", "Fig. 9", "Table 4", "Fig. 11", "
 @pytest.fixture(scope="module")
 def paper_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("paper")
-    runs = out / "runs"
+    runs = out / "runs"  # where paper records without --runs: under --out
     cmd = [sys.executable, "-m", "fleet.cli", "paper", "--quick", "--out", str(out)]
-    done = subprocess.run([*cmd, "--runs", str(runs)], capture_output=True, text=True, timeout=600)
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     return out, runs, done
 

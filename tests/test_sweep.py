@@ -286,3 +286,20 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def test_progress_counts_reused_runs_and_gives_an_eta_from_the_second_run_made(tiny):
+    import io
+
+    from fleet.sweep.runner import Finished, SweepProgress
+
+    runs = build_grid(str(tiny), [], [parse_vary("obstacles.walker.start_at=0:3:1")])
+    stream = io.StringIO()
+    progress = SweepProgress(len(runs), stream)
+    for i, run in enumerate(runs):
+        progress(Finished(run, Path(f"{run.name}.mcap"), reused=i == 0))
+    lines = stream.getvalue().splitlines()
+    assert lines[0].startswith("sweep: 1/4 done (1 already recorded): ")
+    assert "ETA" not in lines[1]  # one run made: no pace yet
+    assert "ETA" in lines[2] and "ETA" not in lines[3]  # the last has nothing left
+    assert lines[3].startswith("sweep: 4/4 done (1 already recorded): ")

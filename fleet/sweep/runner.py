@@ -143,7 +143,7 @@ def execute_sweep(
 
 class SweepProgress:
     """Lines on stderr: runs done of all, how many were reused, and the time left at the
-    pace of the runs made so far."""
+    pace of the runs made since the first one (starting the workers is not a run's time)."""
 
     def __init__(self, total: int, stream, quiet: bool = False):
         self.total = total
@@ -151,17 +151,21 @@ class SweepProgress:
         self.quiet = quiet
         self.done = 0
         self.reused = 0
-        self.started = time.perf_counter()
+        self.first_made: float | None = None
 
     def __call__(self, finished: Finished) -> None:
         self.done += 1
         self.reused += finished.reused
+        now = time.perf_counter()
+        made = self.done - self.reused
+        if made == 1 and not finished.reused:
+            self.first_made = now
         if self.quiet:
             return
-        made = self.done - self.reused
-        elapsed = time.perf_counter() - self.started
         left = self.total - self.done
-        eta = f", ETA {_duration(elapsed / made * left)}" if made and left else ""
+        eta = ""
+        if made > 1 and left and self.first_made is not None:
+            eta = f", ETA {_duration((now - self.first_made) / (made - 1) * left)}"
         reused = f" ({self.reused} already recorded)" if self.reused else ""
         print(
             f"sweep: {self.done}/{self.total} done{reused}{eta}: {finished.recording.name}",
