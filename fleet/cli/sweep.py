@@ -14,12 +14,6 @@ from pathlib import Path
 
 from fleet import exit_codes
 from fleet.cli.arguments import UsageError
-from fleet.runtime.interrupts import interrupts_raised
-from fleet.sweep.folder import sweep_entry, write_manifest
-from fleet.sweep.grid import build_grid
-from fleet.sweep.keys import parse_vary
-from fleet.sweep.runner import SweepProgress, execute_sweep, local_pool
-from recordings.sweep_report import SweepEntry, stats_csv, stats_table, sweep_json, variant_stats
 
 DEFAULT_OUT = "runs/sweep-{scenario}"
 STATS_CSV = "stats.csv"
@@ -91,6 +85,14 @@ def _workers(text: str) -> int:
 
 
 def run_sweep(args: argparse.Namespace) -> int:
+    # imported here, as the other commands' heavy parts are: every agv-fleet process (the
+    # world, each AGV) imports the CLI, and tomlkit and the statistics are 0.3 s of it
+    from fleet.runtime.interrupts import interrupts_raised
+    from fleet.sweep.folder import sweep_entry, write_manifest
+    from fleet.sweep.grid import build_grid
+    from fleet.sweep.keys import parse_vary
+    from fleet.sweep.runner import SweepProgress, execute_sweep, local_pool
+
     if args.cluster and args.workers:
         raise UsageError("--workers is for this machine; a cluster has its own workers")
     vary = [parse_vary(v) for v in args.vary]
@@ -107,7 +109,7 @@ def run_sweep(args: argparse.Namespace) -> int:
         executor = local_pool(args.workers or os.cpu_count() or 1)
     write_manifest(out, args.scenario, vary, over, runs)
     progress = SweepProgress(len(runs), sys.stderr, quiet=args.quiet)
-    measured: dict[Path, SweepEntry] = {}
+    measured: dict = {}  # recording path -> SweepEntry
 
     def finished(done, rec) -> None:
         run = done.run
@@ -131,8 +133,11 @@ def run_sweep(args: argparse.Namespace) -> int:
     return exit_codes.OK
 
 
-def print_sweep(args, entries: list[SweepEntry], over: list[str], out: Path | None) -> None:
-    """The sweep's statistics as ``args`` asks (shared with ``analyze DIR``)."""
+def print_sweep(args, entries: list, over: list[str], out: Path | None) -> None:
+    """The sweep's statistics (``entries``: ``SweepEntry``) as ``args`` asks (shared with
+    ``analyze DIR``)."""
+    from recordings.sweep_report import stats_csv, stats_table, sweep_json, variant_stats
+
     stats = variant_stats(entries)
     if out is not None:
         (out / STATS_CSV).write_text(stats_csv(stats))

@@ -20,7 +20,7 @@ import tomllib
 from dataclasses import dataclass
 
 import tomlkit
-from tomlkit.items import AoT, Array, InlineTable, Table
+from tomlkit.items import AoT, Array
 
 from fleet.toml_schema import ScenarioError
 
@@ -119,8 +119,8 @@ def apply(doc: tomlkit.TOMLDocument, key: str, value) -> None:
         if isinstance(node, AoT | Array | list):
             node = _entry(node, part, where)
         elif isinstance(node, dict):
-            if part not in node:
-                node[part] = tomlkit.inline_table() if _inside_entry(node, doc) else tomlkit.table()
+            if part not in node:  # a new table: inline below the top (TOML allows it there)
+                node[part] = tomlkit.table() if node is doc else tomlkit.inline_table()
             node = node[part]
         else:
             raise SweepKeyError(f"{key}: {'.'.join(parts[:depth])} is a value, not a table")
@@ -130,12 +130,6 @@ def apply(doc: tomlkit.TOMLDocument, key: str, value) -> None:
     if isinstance(node, AoT | Array | list):
         raise SweepKeyError(f"{key}: {'.'.join(parts[:-1])} is a list: name one of its entries")
     node[last] = value
-
-
-def _inside_entry(node, doc) -> bool:
-    """Whether ``node`` is below the top level: a new table there is written inline, which
-    TOML allows inside an array of tables' entry."""
-    return node is not doc and isinstance(node, Table | InlineTable | dict)
 
 
 def _entry(items, part: str, where: str):
