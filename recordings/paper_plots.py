@@ -68,7 +68,8 @@ def _legend_below(figure: Figure, axes) -> None:
             ncol=min(len(entries), 3), fontsize="small", frameon=False,
         )  # fmt: skip
         lines = math.ceil(len(entries) / 3)  # a legend line is about 0.25 in high
-        figure.tight_layout(rect=(0, min(0.4, (0.25 * lines + 0.2) / figure.get_figheight()), 1, 1))
+        bottom = min(0.4, (0.25 * lines + 0.2) / figure.get_figheight())
+        figure.tight_layout(rect=(0, bottom, 1, 0.97))  # room for the panels' titles
     else:
         figure.tight_layout()
 
