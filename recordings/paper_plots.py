@@ -37,6 +37,26 @@ def _draw_map(ax, grid: GridMap | None) -> None:
         return
     draw_map(ax, grid)
     ax.tick_params(labelsize="x-small")
+    ax.set_xlabel("x (m)", fontsize="x-small")
+    ax.set_ylabel("y (m)", fontsize="x-small")
+
+
+def _legend_below(figure: Figure, axes) -> None:
+    """One legend for every panel, under them: off the maps and the curves."""
+    entries: dict[str, object] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            entries.setdefault(label, handle)
+    if entries:
+        figure.legend(
+            list(entries.values()), list(entries), loc="lower center",
+            ncol=min(len(entries), 3), fontsize="small", frameon=False,
+        )  # fmt: skip
+        lines = math.ceil(len(entries) / 3)  # a legend line is about 0.25 in high
+        bottom = min(0.4, (0.25 * lines + 0.2) / figure.get_figheight())
+        figure.tight_layout(rect=(0, bottom, 1, 0.97))  # room for the panels' titles
+    else:
+        figure.tight_layout()
 
 
 def plans_figure(
@@ -55,8 +75,7 @@ def plans_figure(
             ax.plot(nodes[:, 0], nodes[:, 1], color=colour, ls=style, lw=1.3, label=algorithm)
             ax.plot(nodes[:, 0], nodes[:, 1], ".", color=colour, ms=4)
         ax.set_title(title, fontsize="small")
-    axes[0].legend(fontsize="x-small", loc="lower right")
-    figure.tight_layout()
+    _legend_below(figure, axes)
     return save_figure(figure, path, DPI)
 
 
@@ -69,6 +88,7 @@ def spread_figure(values: dict[str, dict[str, list[float]]], labels: dict[str, s
         ax.boxplot([per_algorithm[n] for n in names], widths=0.5)
         ax.set_xticks(range(1, len(names) + 1), names, fontsize="small")
         ax.set_title(labels.get(metric, metric), fontsize="small")
+        ax.set_xlabel("A* variant, over the seeded maps", fontsize="x-small")
         ax.tick_params(labelsize="x-small")
         ax.grid(True, axis="y", lw=0.4, alpha=0.6)
     figure.tight_layout()
@@ -86,26 +106,27 @@ def trajectories_figure(
         draw_temporary_cells(ax, series)
         mov = series.moving.columns
         for m in range(len(series.moving.names)):
-            ax.plot(mov["x"][:, m], mov["y"][:, m], color="tab:gray", lw=1.0, ls="--")
+            track = mov["x"][:, m], mov["y"][:, m]
+            ax.plot(*track, color="tab:gray", lw=1.0, ls="--", label="moving obstacle's track")
         cols = series.agvs.columns
         for i, name in enumerate(series.agvs.names):
             first = next((p for p in series.plans.get(name, []) if p.get("found")), None)
             if first is not None:
                 nodes = np.asarray(first["key_nodes"], dtype=float).reshape(-1, 2)
-                ax.plot(nodes[:, 0], nodes[:, 1], "k:", lw=1.0)
-                ax.plot(nodes[:, 0], nodes[:, 1], "o", mfc="none", mec="k", ms=4)
+                ax.plot(nodes[:, 0], nodes[:, 1], "k:", lw=1.0, label="first global plan")
+                ax.plot(nodes[:, 0], nodes[:, 1], "o", mfc="none", mec="k", ms=4, label="key nodes")
             x, y = cols["x"][:, i], cols["y"][:, i]
-            ax.plot(x, y, color="tab:red", lw=1.5)
+            ax.plot(x, y, color="tab:red", lw=1.5, label="driven trajectory")
             if len(x):
-                ax.plot(x[0], y[0], "^", color="tab:blue", ms=6)
+                ax.plot(x[0], y[0], "^", color="tab:blue", ms=6, label="start")
         ax.set_title(title, fontsize="small")
-    figure.tight_layout()
+    _legend_below(figure, axes)
     return save_figure(figure, path, DPI)
 
 
 def velocity_figure(runs: Sequence[RunSeries], labels: Sequence[str], path: Path) -> Path:
     """v(t) and ω(t) of the first AGV of each run, overlaid (the paper's Fig. 11)."""
-    figure = Figure(figsize=(7.0, 4.2))
+    figure = Figure(figsize=(8.2, 4.2))
     speed_ax, omega_ax = figure.subplots(2, 1, sharex=True)
     for n, (series, label) in enumerate(zip(runs, labels, strict=True)):
         c = {f: v[:, 0] for f, v in series.agvs.columns.items()}
@@ -121,6 +142,34 @@ def velocity_figure(runs: Sequence[RunSeries], labels: Sequence[str], path: Path
     omega_ax.set_xlabel("sim time (s)")
     for ax in (speed_ax, omega_ax):
         ax.grid(True, lw=0.4, alpha=0.6)
-        ax.legend(fontsize="x-small", loc="upper right")
+    speed_ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    figure.tight_layout()  # the legend right of the curves: it covers none of them
+    return save_figure(figure, path, DPI)
+
+
+def changes_figure(
+    changes: dict[str, list[float]], paper: dict[str, float | None], title: str, path: Path
+) -> Path:
+    """One box per effect: our % changes (one per walker timing, as dots) with the paper's
+    value marked (an effect the paper shows only in a figure has none)."""
+    figure = Figure(figsize=(max(6.0, 1.6 * len(changes) + 2.5), 4.2))
+    ax = figure.add_subplot()
+    names = list(changes)
+    ax.boxplot([changes[n] or [math.nan] for n in names], widths=0.5, showmeans=True)
+    labels = {"ours": "ours, one walker timing each", "paper": "the paper's value"}
+    for i, name in enumerate(names, 1):
+        values = changes[name]
+        ax.plot([i] * len(values), values, ".", color="tab:blue", alpha=0.5, ms=5,
+                label=labels.pop("ours", None))  # fmt: skip
+        if paper.get(name) is not None:
+            ax.plot(i, paper[name], "x", color="tab:red", ms=10, mew=2.5,
+                    label=labels.pop("paper", None))  # fmt: skip
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xticks(range(1, len(names) + 1), names, fontsize="small")
+    ax.set_ylabel("change, fusion vs astar-dwa (%)")
+    ax.set_xlabel("effect (box: quartiles, line: median, ▲: mean)")
+    ax.set_title(title, fontsize="small")
+    ax.grid(True, axis="y", lw=0.4, alpha=0.6)
+    ax.legend(fontsize="small", loc="upper left", bbox_to_anchor=(1.01, 1.0))
     figure.tight_layout()
     return save_figure(figure, path, DPI)

@@ -11,13 +11,16 @@ import sys
 import pytest
 
 from fleet.paper import published
-from fleet.paper.markdown import fmt_pct
+from fleet.paper.claims import AGREES, DIRECTION_ONLY, DISAGREES, judge
+from fleet.paper.markdown import change_interval, fmt_pct
 from fleet.paper.plan_sections import PLAN_METRICS
 from fleet.paper.prose import Prose, parts
+from fleet.paper.timing_sweep import TIMING_KEY
 from fleet.scenario import load_scenario
 from recordings.analysis import analyze, percent_change
 from recordings.plan_metrics import map_plans
 from recordings.reader import open_recording
+from recordings.sweep_stats import describe
 
 EXPERIMENTS = ("Table 2", "Table 3", "Fig. 8", "Fig. 9", "Table 4", "Fig. 11", "smoothness")
 
@@ -25,9 +28,9 @@ EXPERIMENTS = ("Table 2", "Table 3", "Fig. 8", "Fig. 9", "Table 4", "Fig. 11", "
 @pytest.fixture(scope="module")
 def paper_run(tmp_path_factory):
     out = tmp_path_factory.mktemp("paper")
-    runs = out / "runs"
+    runs = out / "runs"  # where paper records without --runs: under --out
     cmd = [sys.executable, "-m", "fleet.cli", "paper", "--quick", "--out", str(out)]
-    done = subprocess.run([*cmd, "--runs", str(runs)], capture_output=True, text=True, timeout=120)
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     return out, runs, done
 
@@ -151,7 +154,46 @@ def test_every_claim_compares_with_a_published_value(paper_run):
     summary = _sections((out / "paper-reproduction.md").read_text())["Summary"]
     rows = [_cells(line) for line in _tables(summary)[0][2:]]
     assert [row[1] for row in rows] == _paper_cells_from_published()
-    assert all(row[3] in ("agrees", "**DISAGREES**") for row in rows)
+    assert all(row[3] in ("agrees", "direction only", "**DISAGREES**") for row in rows)
+
+
+def test_table4_over_walker_timings_is_the_statistics_of_the_sweep_recordings(paper_run):
+    out, runs, _ = paper_run
+    by_key = {}
+    for path in (runs / "sweep").glob("*.mcap"):
+        rec = open_recording(path)
+        values = rec.run["sweep"]
+        key = (values["variant"]["planner.algorithm"], values["sample"][TIMING_KEY])
+        by_key[key] = analyze(rec)
+    timings = sorted({t for _, t in by_key})
+    assert len(timings) >= 3 and len(by_key) == 2 * len(timings)
+    changes = [
+        percent_change(by_key[("fusion", t)].run_time, by_key[("astar-dwa", t)].run_time)
+        for t in timings
+    ]
+    stats = describe(changes)
+    sections = _sections((out / "paper-reproduction.md").read_text())
+    table4 = next(s for h, s in sections.items() if h.startswith("Table 4"))
+    row = _row(table4, "| run time |")
+    assert row[4] == change_interval(stats)
+    assert row[5] == judge(stats, percent_change(
+        published.TABLE4["fusion"].run_time, published.TABLE4["astar-dwa"].run_time
+    ))  # fmt: skip
+    assert f"over {len(timings)} walker starts" in table4
+
+
+def _stats(values):
+    return describe(values)
+
+
+def test_the_verdict_rule_looks_at_direction_size_and_spread():
+    assert judge(_stats([-10.0, -12.0, -14.0]), -12.0) == AGREES
+    assert judge(_stats([-10.0, -12.0, -14.0]), -40.0) == DIRECTION_ONLY  # too small
+    assert judge(_stats([-30.0, 5.0, -10.0]), -12.0) == DIRECTION_ONLY  # reaches zero
+    assert judge(_stats([-5.0, 20.0, 10.0]), -12.0) == DISAGREES
+    assert judge(_stats([-5.0, -6.0, -7.0]), None) == AGREES  # "lower", figure only
+    assert judge(_stats([-30.0, 5.0, -10.0]), None) == DIRECTION_ONLY
+    assert judge(_stats([3.0, 4.0]), None) == DISAGREES
 
 
 def test_the_paper_scenarios_run_the_published_motion_limits():

@@ -13,7 +13,7 @@ import sys
 from importlib.metadata import version
 
 from fleet import exit_codes
-from fleet.cli import nodes, paper, plan, recordings, replay, run, scenarios
+from fleet.cli import nodes, paper, plan, recordings, replay, run, scenarios, sweep
 from planner.core.errors import AgvFleetError
 
 
@@ -35,6 +35,7 @@ def build_parser() -> argparse.ArgumentParser:
     recordings.add_parsers(sub)
     replay.add_parsers(sub)
     paper.add_parsers(sub)
+    sweep.add_parsers(sub)
     return parser
 
 

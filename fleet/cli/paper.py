@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -10,7 +11,7 @@ from pathlib import Path
 from fleet import exit_codes
 
 DEFAULT_OUT = "paper-report"
-DEFAULT_RUNS = "runs/paper"
+RUNS_IN_OUT = "runs"  # the recordings' folder inside --out, unless --runs says otherwise
 
 
 def add_parsers(sub) -> None:
@@ -31,9 +32,17 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--runs",
-        default=DEFAULT_RUNS,
         metavar="DIR",
-        help=f"recordings folder (default {DEFAULT_RUNS}); its plans/ and fleet/ are replaced",
+        help=(
+            f"recordings folder (default: OUT/{RUNS_IN_OUT}, ignored by git); its plans/, "
+            "fleet/ and sweep/ are replaced"
+        ),
+    )
+    p.add_argument(
+        "--workers",
+        type=_count,
+        metavar="N",
+        help="processes for the walker-timing sweep (default: one per core)",
     )
     p.add_argument(
         "--maps50",
@@ -41,7 +50,9 @@ def add_parsers(sub) -> None:
         metavar="N",
         help="seeded 50x50 maps with a path to compare (default 50; 5 with --quick)",
     )
-    p.add_argument("--quick", action="store_true", help="fewer random maps (for tests)")
+    p.add_argument(
+        "--quick", action="store_true", help="fewer random maps and walker timings (for tests)"
+    )
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run_paper)
 
@@ -60,6 +71,7 @@ def run_paper(args: argparse.Namespace) -> int:
     # imported here: matplotlib and the experiment code are only needed by this command
     from fleet.paper.experiments import DEFAULT_MAPS50, QUICK_MAPS50, run_experiments
     from fleet.paper.report import write_report
+    from fleet.runtime.interrupts import interrupts_raised
 
     maps50 = args.maps50 or (QUICK_MAPS50 if args.quick else DEFAULT_MAPS50)
     t0 = time.perf_counter()
@@ -68,7 +80,10 @@ def run_paper(args: argparse.Namespace) -> int:
         if not args.quiet:
             print(f"[{time.perf_counter() - t0:6.1f} s] {line}", file=sys.stderr, flush=True)
 
-    results = run_experiments(Path(args.runs), maps50, log)
+    runs = Path(args.runs) if args.runs else Path(args.out) / RUNS_IN_OUT
+    workers = args.workers or os.cpu_count() or 1
+    with interrupts_raised():  # SIGTERM too: the sweep's pool is stopped, not orphaned
+        results = run_experiments(runs, maps50, log, workers, quick=args.quick)
     t1 = time.perf_counter()
     path = write_report(results, Path(args.out))
     results.timings["report"] = time.perf_counter() - t1

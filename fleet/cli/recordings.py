@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from fleet import exit_codes
+from fleet.cli.arguments import UsageError
 from recordings.analysis import analyze
 from recordings.info import describe, describe_json
 from recordings.reader import Recording, RecordingError, open_recording
@@ -47,7 +48,12 @@ def add_parsers(sub) -> None:
             "columns (--wide: every column); runs are named by scenario and algorithm."
         ),
     )
-    analyze_parser.add_argument("recordings", nargs="+", metavar="REC.mcap")
+    analyze_parser.add_argument(
+        "recordings",
+        nargs="+",
+        metavar="REC.mcap",
+        help="recordings, or one folder of agv-fleet sweep: its statistics per variant",
+    )
     output = analyze_parser.add_mutually_exclusive_group()
     output.add_argument("--json", action="store_true", help="print one JSON object")
     output.add_argument(
@@ -86,6 +92,9 @@ def run_info(args: argparse.Namespace) -> int:
 
 
 def run_analyze(args: argparse.Namespace) -> int:
+    folders = [Path(p) for p in args.recordings if Path(p).is_dir()]
+    if folders:
+        return _analyze_sweep(args, folders)
     runs = []
     for path in args.recordings:
         rec = open_recording(path)
@@ -116,4 +125,27 @@ def run_analyze(args: argparse.Namespace) -> int:
         print("\n\n".join(run_table(r, wide=args.wide) for r in runs))
         if len(runs) > 1:
             print("\n" + comparison_table(runs))
+    return exit_codes.OK
+
+
+def _analyze_sweep(args: argparse.Namespace, folders: list[Path]) -> int:
+    """``analyze DIR``: a sweep's folder read as ``agv-fleet sweep`` prints it."""
+    # imported here: the sweep's code is only needed for a folder
+    from fleet.cli.sweep import print_sweep
+    from fleet.sweep.folder import folder_entries
+
+    if len(args.recordings) > 1:
+        raise UsageError("give one sweep folder, or recordings (not both, not two folders)")
+    if args.wide:
+        raise UsageError("--wide is for recordings; a sweep folder's table fits 100 columns")
+    entries, missing, over = folder_entries(folders[0])
+    if missing:
+        print(
+            f"agv-fleet analyze: {missing} runs of {folders[0]} have no finished recording "
+            "(agv-fleet sweep with the same arguments makes them)",
+            file=sys.stderr,
+        )
+    if not entries:
+        raise RecordingError(f"{folders[0]} holds no finished run of its sweep")
+    print_sweep(args, entries, over, out=None)
     return exit_codes.OK

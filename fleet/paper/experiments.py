@@ -17,7 +17,8 @@ report is then built only from those recordings, read back:
   path are recorded too, then skipped and counted.
 - Figs. 8-11, Table 4 and the velocity-smoothness comparison: the built-in paper
   scenarios run in process with one planner variant each, recorded, measured by
-  ``recordings.analysis``.
+  ``recordings.analysis``; Table 4 and the smoothness comparison also over many walker
+  timings (``fleet.paper.timing_sweep``, into ``sweep/``).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ import numpy as np
 
 from bridge.keys import WORLD_MAP, agv_plan
 from fleet.builtin import bundled_maps
+from fleet.paper.timing_sweep import TimingSweep, record_timing_sweep
 from fleet.runtime.agv_node import plan_message
 from fleet.runtime.inprocess import run_recorded
 from fleet.runtime.world import map_message
@@ -96,6 +98,7 @@ class PaperResults:
     # the same maps planned with the default profile (costmap, footprint-safe key nodes)
     grid20_default: list[MapPlans] = field(default_factory=list)
     random50_default: list[MapPlans] = field(default_factory=list)
+    timing: TimingSweep | None = None  # paper-dynamic over many walker starts
 
     def run(self, scenario: str, algorithm: str) -> FleetRun:
         return self.fleet[(scenario, algorithm)]
@@ -235,12 +238,16 @@ def record_fleet_run(fleet_dir: Path, scenario: Scenario) -> Path:
     return path
 
 
-def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
-    """Record every experiment under ``runs_dir``, then read every recording back."""
-    plan_dir, fleet_dir = runs_dir / "plans", runs_dir / "fleet"
-    for folder in (plan_dir, fleet_dir):
+def run_experiments(
+    runs_dir: Path, maps50: int, log: Log, workers: int = 1, quick: bool = False
+) -> PaperResults:
+    """Record every experiment under ``runs_dir``, then read every recording back; the
+    walker-timing sweep on ``workers`` processes (``quick``: a few timings)."""
+    plan_dir, fleet_dir, sweep_dir = runs_dir / "plans", runs_dir / "fleet", runs_dir / "sweep"
+    for folder in (plan_dir, fleet_dir, sweep_dir):
         folder.mkdir(parents=True, exist_ok=True)
-        for old in folder.glob("*.mcap"):  # a smaller --maps50 must not pick up old maps
+        # a smaller --maps50 must not pick up old maps, nor the sweep runs of older code
+        for old in folder.glob("*.mcap"):
             old.unlink()
     timings = {}
     t0 = time.perf_counter()
@@ -263,6 +270,9 @@ def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
             f"({time.perf_counter() - t:.1f} s)"
         )
     timings["fleet"] = time.perf_counter() - t1
+    t = time.perf_counter()
+    timing = record_timing_sweep(sweep_dir, workers, log, quick)
+    timings["walker-timing sweep"] = time.perf_counter() - t
 
     t2 = time.perf_counter()
     results = PaperResults(
@@ -272,6 +282,7 @@ def run_experiments(runs_dir: Path, maps50: int, log: Log) -> PaperResults:
         maps50_wanted=maps50,
         grid20_default=[map_plans(open_recording(p)) for p in grid20_default],
         random50_default=[map_plans(open_recording(p)) for p in random_default],
+        timing=timing,
     )
     for key, path in fleet_paths.items():
         rec = open_recording(path)

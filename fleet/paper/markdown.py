@@ -45,3 +45,18 @@ def recording(path) -> str:
 
 def bullets(items: list[str]) -> str:
     return "\n".join(f"- {item}" for item in items)
+
+
+def change_interval(changes) -> str:
+    """A distribution of % changes (``MetricStats``) as "mean [low, high]" of its 95 % CI."""
+    if changes is None:
+        return MISSING
+    low, high = changes.ci95
+    return f"{changes.mean:+.1f} % [{low:+.1f}, {high:+.1f}]"
+
+
+def change_spread(changes) -> str:
+    """A distribution of % changes as "median (min to max)"."""
+    if changes is None:
+        return MISSING
+    return f"{changes.median:+.1f} % ({changes.min:+.1f} to {changes.max:+.1f})"

@@ -10,7 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fleet.paper import markdown as md
-from fleet.paper.claims import Claim, Claims, direction
+from fleet.paper.claims import Claim, Claims, judge
 from fleet.paper.experiments import RANDOM_GOAL, RANDOM_START, PaperResults
 from fleet.paper.measures import spread
 from fleet.paper.prose import Prose
@@ -18,6 +18,7 @@ from fleet.paper.published import TABLE2, TABLE3, PlanTable
 from recordings import paper_plots
 from recordings.analysis import percent_change
 from recordings.plan_metrics import MapPlans
+from recordings.sweep_stats import describe
 
 # (PlanMetrics and published.PlanRow field, name in the tables)
 PLAN_METRICS = (
@@ -66,18 +67,22 @@ def plan_comparison(
             for s in spreads
         ]
         o_change = percent_change(spreads[1].mean, spreads[0].mean)
-        verdict = direction(o_change, p_change)
+        per_map = [percent_change(new, old) for old, new in zip(*values, strict=True)]
+        changes = describe([c for c in per_map if c is not None]) if maps else None
+        verdict = judge(changes, p_change)
         paper_cell, ours_cell = md.fmt_pct(p_change), md.fmt_pct(o_change)
         paper_cells = [md.fmt(p_old, "{:g}"), md.fmt(p_new, "{:g}"), paper_cell]
-        rows.append([name, *paper_cells, *cells, ours_cell, verdict])
+        interval = md.change_interval(changes)
+        rows.append([name, *paper_cells, *cells, ours_cell, interval, verdict])
         texts = {"label": label, "metric": name}
         claims.add(
-            Claim(prose("claim", **texts), paper_cell, ours_cell, verdict),
+            Claim(prose("claim", **texts), paper_cell, f"{interval} per map", verdict),
             prose("disagreement", **texts, paper=paper_cell, ours=ours_cell),
         )
     stat = f"{ours}, mean ± std [min–max]" if with_spread else f"{ours}, mean"
     header = ["metric", "paper traditional A*", "paper improved A*", "paper change"]
-    header += [f"{stat}: traditional", f"{stat}: improved", f"{ours} change", "direction vs paper"]
+    header += [f"{stat}: traditional", f"{stat}: improved", f"{ours} change of the means"]
+    header += [f"{ours} change per map: mean [95 % CI]", "verdict"]
     return md.table(header, rows)
 
 

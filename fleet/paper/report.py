@@ -11,8 +11,10 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+
 from fleet.paper import markdown as md
-from fleet.paper.claims import Claims
+from fleet.paper.claims import RULE, Claims
 from fleet.paper.dynamic_sections import smoothness, table4
 from fleet.paper.experiments import PaperResults
 from fleet.paper.plan_sections import default_profile, table2, table3
@@ -26,15 +28,26 @@ Section = Callable[[PaperResults, Path, Claims], str]
 SECTIONS: tuple[Section, ...] = (table2, table3, default_profile, fig8, fig9, table4, smoothness)
 
 
-def _paper_run_speed() -> dict[str, str]:
-    """Table 4's run times, length and mean speed, as the closing remarks quote them."""
+def _run_speed(results: PaperResults) -> dict[str, str]:
+    """Table 4's run times, length and mean speed, and ours over the walker timings (fusion's
+    median run time and mean speed), as the closing remarks quote them."""
     rows = TABLE4.values()
     times = [row.run_time for row in rows]
     length = sum(row.path_length for row in rows) / len(rows)
+    timing = results.timing
+    ours = float(np.median(timing.values("fusion", "run_time")))
+    speeds = [
+        d / t
+        for d, t in zip(timing.values("fusion", "distance"), timing.values("fusion", "run_time"))
+        if t
+    ]
     return {
         "paper_run_times": f"{min(times):.0f}–{max(times):.0f}",
         "paper_length": f"{length:.1f}",
         "paper_speed": f"{length / (sum(times) / len(times)):.1f}",
+        "our_run_time": f"{ours:.1f}",
+        "time_ratio": f"{sum(times) / len(times) / ours:.1f}",
+        "our_speed": f"{float(np.mean(speeds)):.2f}",
     }
 
 
@@ -46,12 +59,15 @@ def build_report(results: PaperResults, figures: Path) -> str:
     config = results.config
     plan_recordings = len(results.grid20) + len(results.random50)
     summary = md.table(
-        ["claim", "paper", "ours", "direction"],
+        ["claim", "paper", "ours", "verdict"],
         [[c.claim, c.paper, c.ours, c.verdict] for c in claims.rows],
     )
     text = prose(
         citation=CITATION,
-        recordings=plan_recordings + len(results.fleet),
+        recordings=plan_recordings + len(results.fleet) + len(results.timing.runs),
+        sweep_recordings=len(results.timing.runs),
+        rule=RULE,
+        direction_only="; ".join(claims.direction_only) or prose("nowhere"),
         plan_recordings=plan_recordings,
         fleet_recordings=len(results.fleet),
         max_speed=f"{MOTION.max_speed:g}",
@@ -69,7 +85,7 @@ def build_report(results: PaperResults, figures: Path) -> str:
         safety_distance=f"{config.safety_distance:g}",
         timings=", ".join(f"{k} {v:.1f} s" for k, v in results.timings.items()),
         runs_dir=results.runs_dir,
-        **_paper_run_speed(),
+        **_run_speed(results),
     )
     return text + "\n"
 

@@ -1,0 +1,65 @@
+"""A sweep's box plots: per metric, one box per variant over its runs (Agg, no display)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from recordings.sweep_report import UNITS, SweepEntry, variant_label
+from recordings.sweep_stats import metric_order, numeric_fields
+
+DPI = 100
+
+
+def save_box_plots(entries: Sequence[SweepEntry], out_dir: Path, title: str) -> list[Path]:
+    """``<metric>.png`` in ``out_dir`` for every metric with a value in some run."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    variants: dict[str, tuple[dict, list[dict]]] = {}
+    for e in entries:
+        variants.setdefault(repr(sorted(e.variant.items())), (e.variant, []))[1].append(
+            numeric_fields(e.run)
+        )
+    names = metric_order({k for _, runs in variants.values() for r in runs for k in r})
+    keys = list(entries[0].variant) if entries else []
+    samples = list(entries[0].sample) if entries else []
+    paths = []
+    for name in names:
+        groups = [
+            (variant, [r[name] for r in runs if r.get(name) is not None])
+            for variant, runs in variants.values()
+        ]
+        if not any(values for _, values in groups):
+            continue
+        figure = box_figure(name, groups, keys, samples, title)
+        FigureCanvasAgg(figure)
+        path = out_dir / f"{name}.png"
+        figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
+        paths.append(path)
+    return paths
+
+
+def box_figure(name: str, groups, keys: list[str], samples: list[str], title: str) -> Figure:
+    """One box per variant (its runs' values as points on top)."""
+    figure = Figure(figsize=(max(7.0, 1.2 * len(groups) + 2.0), 4.8))
+    ax = figure.add_subplot()
+    data = [values or [float("nan")] for _, values in groups]
+    ax.boxplot(data, showmeans=True, meanprops={"marker": "^", "markerfacecolor": "white"})
+    for i, values in enumerate(data, 1):
+        ax.plot([i] * len(values), values, ".", color="tab:blue", alpha=0.5, ms=4)
+    ax.set_xticks(range(1, len(groups) + 1))
+    ax.set_xticklabels([variant_label(v) for v, _ in groups], rotation=20, ha="right")
+    unit = UNITS.get(name)
+    ax.set_ylabel(f"{name} ({unit})" if unit else name)
+    ax.set_xlabel(", ".join(keys) if keys else "variant")
+    over = f", over {', '.join(samples)}" if samples else ""
+    ax.set_title(
+        f"{title}: {name} per variant{over}\nbox: quartiles, line: median, ▲: mean, dots: runs",
+        fontsize="medium",
+        wrap=True,
+    )
+    ax.grid(True, axis="y", lw=0.4, alpha=0.6)
+    figure.tight_layout()
+    return figure
