@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -359,3 +360,11 @@ def test_the_steady_choice_breaks_ties_by_score_then_first():
     change = np.array([0.5, 0.1, 0.1, 0.1, 0.0])
     # within 10 % of the spread of the best: 0..3; least change: 1, 2, 3; best score: 2, 3
     assert steady_choice(score, change, 0.1, np.zeros(5), 0.0, 0.01) == 2
+
+
+def test_config_numbers_are_floats_whatever_the_file_wrote():
+    """A scenario file may write ``max_accel = 1``: the kernels still see one type (a new
+    type would compile them again mid-run, after the warm-up)."""
+    config = DwaConfig(max_accel=1, max_speed=2, dt=0.1)
+    assert all(type(getattr(config, f.name)) is float for f in dataclasses.fields(config))
+    assert config.max_accel == 1.0

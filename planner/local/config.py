@@ -37,6 +37,9 @@ class DwaConfig:
             value = getattr(self, f.name)
             if not (isinstance(value, numbers.Real) and math.isfinite(value)):
                 raise ValueError(f"DWA {f.name} must be a finite number, got {value!r}")
+            # one type for every number: a compiled kernel given an int where it was warmed
+            # up with a float would compile again mid-run
+            object.__setattr__(self, f.name, float(value))
         positive = (
             "max_speed", "max_accel", "max_omega", "max_alpha", "v_resolution",
             "omega_resolution", "dt", "predict_time", "radius", "clearance_cap",
