@@ -115,6 +115,8 @@ def add_parsers(sub) -> None:
         metavar="S",
         help="give up when no router answers within S seconds (default 30)",
     )
+    # the launcher's pipe for "an AGV process ended abnormally" (fleet.runtime.agv_host)
+    a.add_argument("--exits-fd", type=int, help=argparse.SUPPRESS)
     a.set_defaults(handler=run_agv)
 
     r = sub.add_parser(
@@ -195,6 +197,7 @@ def run_agv(args: argparse.Namespace) -> int:
         zenoh_config=args.zenoh_config,
         logins=logins,
         grace=args.grace,
+        exits_fd=args.exits_fd,
     )
 
 

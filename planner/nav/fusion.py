@@ -63,7 +63,7 @@ from planner.nav.recovery import DURATION_S, RECOVERIES, Recovery, is_stopped, r
 from planner.nav.tight_turns import Corner, approach_command, approach_path, corners, stopped_enough
 from planner.nav.trail import Trail
 from planner.route.global_planner import DEFAULT_SAFETY_DISTANCE, PlanResult, plan_global
-from planner.route.parked_discs import blocking_cells
+from planner.route.parked_discs import blocking_cells, held_point
 from planner.route.route_check import blocked_point
 
 VARIANTS = ("fusion", "astar-dwa", "dwa")
@@ -193,6 +193,7 @@ class FusionController:
         self.trail = Trail()  # the way it came: where a head-on walker walks on
         self._route_stale = False  # new obstacles sensed since the route was last checked
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
+        self.parked_by: list = []  # ((x, y), radius, who) of those AGVs, to name them
         self._rounded: set[Cell] = set()  # cells of standing walkers a replan went round
         self._parked_in_way = False  # one of them is on the route: replan
 
@@ -228,7 +229,8 @@ class FusionController:
         if plan.found and moving is not None and costmap is not None:
             plan = self._round_parked(plan, position, moving)
         if not plan.found:
-            parked = " and the AGVs stopped for good" if self.parked else ""
+            who = "; ".join(label for _, _, label in self.parked_by)
+            parked = f" and the AGVs stopped for good ({who})" if self.parked else ""
             self.failure = self.failure or f"no path to the goal on the known map{parked}"
             self.status = "failed"
             self.targets = []
@@ -263,7 +265,8 @@ class FusionController:
                 costmap=costmap,
             )
         except MapError as err:  # e.g. standing in a cell now known to be blocked
-            self.failure = str(err)
+            points = {"goal": self.goal, "start": position}
+            self.failure = held_point(self.grid, points, self.parked_by) or str(err)
             return PlanResult(_GLOBAL_ALGORITHM[self.config.algorithm], position, self.goal, False)
 
     def see(self, cells) -> bool:
@@ -406,11 +409,13 @@ class FusionController:
         still ahead."""
         return [self._segment_start(), *self.targets[self.target_index :]]
 
-    def park(self, discs) -> None:
+    def park(self, discs, labels=()) -> None:
         """AGVs that stopped for good (arrived, failed) at (x, y, radius): obstacles for
-        every later global plan (DWA sees them as discs anyway)."""
+        every later global plan (DWA sees them as discs anyway); ``labels`` name them in a
+        failure they cause."""
         if self.costmap is None:
             return
+        self.parked_by = [((x, y), r, label) for (x, y, r), label in zip(discs, labels)]
         cells = set()
         for x, y, radius in discs:
             cells |= cells_in_disc(self.grid, (x, y), radius)
