@@ -9,14 +9,16 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
+from PIL import Image
 
+from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import ScenarioError, load_scenario
 from planner.maps.clearance import Clearance, keeps
 from planner.maps.costmap import Costmap, point_clearance
 from planner.maps.grid import GridMap
 from planner.maps.ros_map import load_ros_map
 from planner.route.key_nodes import extract_key_nodes
-from tests.test_map_images import DATA
+from tests.test_map_images import DATA, pgm_pixels, twin
 
 RESOLUTIONS_MM = (20, 30, 50, 100)
 RADII_MM = range(100, 501)
@@ -112,3 +114,50 @@ def test_a_turtlebot_sized_agv_can_be_placed_where_it_fits(tmp_path, radius):
     path.write_text(SCENARIO.format(map=DATA / "tb3_sandbox.yaml", radius=radius, x=x, y=y))
     with pytest.raises(ScenarioError, match=r"start .* m from an obstacle or the map's edge"):
         load_scenario(path)
+
+
+TB3_SANDBOX_RUN = """
+name = "tb3-sandbox-3"
+description = "Three TurtleBot3-sized AGVs (radius 0.105 m) between the sandbox pillars"
+dt = 0.1
+time_limit = 200
+
+[map]
+file = "MAP"
+
+[planner]
+algorithm = "fusion"
+margin = 0.1
+
+[agv_defaults]
+radius = 0.105
+max_speed = 0.5
+
+[[agvs]]
+name = "tb1"
+start = [-1.8, 0.0]
+goal = [1.8, 0.0]
+
+[[agvs]]
+name = "tb2"
+start = [0.0, 1.8]
+goal = [0.0, -1.8]
+heading = -90
+
+[[agvs]]
+name = "tb3"
+start = [1.6, -1.0]
+goal = [-1.6, 1.0]
+heading = 180
+"""
+
+
+def test_three_turtlebot_sized_agvs_cross_the_tb3_sandbox_png_and_all_arrive(tmp_path):
+    """The TurtleBot3 sandbox (5 cm cells, read from a PNG twin of Nav2's PGM): three
+    0.105 m AGVs between its pillars, every one arrives with no collision."""
+    png = twin(tmp_path, "tb3_sandbox", Image.fromarray(pgm_pixels("tb3_sandbox"), "L"), ".png")
+    path = tmp_path / "tb3.toml"
+    path.write_text(TB3_SANDBOX_RUN.replace("MAP", str(png)))
+    summary = run_in_process(load_scenario(path))
+    assert summary.success, summary.table()
+    assert [a.status for a in summary.agvs] == ["arrived"] * 3
