@@ -31,7 +31,7 @@ from planner.core.limits import read_input_file
 from planner.core.motion import CONTROL_PERIOD
 from planner.core.profiles import DEFAULT, PROFILES
 from planner.local.config import DwaConfig
-from planner.maps.clearance import ClearanceError, clearance_for
+from planner.maps.clearance import ClearanceError, clearance_for, keeps
 from planner.maps.costmap import point_clearance
 from planner.maps.grid import GridMap
 from planner.maps.loaders import load_map
@@ -317,9 +317,10 @@ def _parse_agvs(
             except MapError as err:
                 raise ScenarioError(f"{who}: {err}") from None
             room = point_clearance(grid, point, config.dwa.radius)
-            if room < config.dwa.radius:
+            if not keeps(room, config.dwa.radius):
+                shown = math.floor(room * 1e4 + 1e-6) / 1e4  # not rounded up to the radius
                 raise ScenarioError(
-                    f"{who}: {what} ({point[0]:g}, {point[1]:g}) is {room:.3f} m from an obstacle "
+                    f"{who}: {what} ({point[0]:g}, {point[1]:g}) is {shown:.4f} m from an obstacle "
                     f"or the map's edge, less than the AGV radius {config.dwa.radius:g} m"
                 )
         heading = get_number(entry, "heading", where, default=0.0)

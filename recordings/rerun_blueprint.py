@@ -1,29 +1,34 @@
 """The viewer layout: a tab for the fleet, and a tab per AGV that follows it.
 
-Fleet tab: the map, fitted to its panel, over the events; beside it |v| and ω of
-every AGV over the whole run, the time axis running past the end so that the
-legend (a corner of the plot) sits beside the data, not on it. AGV tabs: a view
-centred on the AGV (its ``pose/follow`` frame) beside its own plots, body-frame
-vx and vy included. A replay opens paused at the start of the run (or playing it
-at a given rate); a live run follows the latest data.
+Fleet tab: the map, fitted to its panel, over the events; beside it the fleet as a
+whole (``recordings.rerun_fleet``: AGVs driving, waiting, stopped; arrivals so far)
+over the whole run, the time axis running past the end so that the legend (a corner
+of the plot) sits beside the data, not on it. AGV tabs, one for every AGV: a view
+centred on the AGV (its ``pose/follow`` frame) beside its own plots (|v|, ω, body-frame
+vx and vy), each with a legend naming it. (Twenty AGVs' curves in one plot could not
+be told apart, and Rerun's legend showed only the first ten.) A replay opens paused
+at the start of the run (or playing it at a given rate); a live run follows the
+latest data. Send it before the data: until a blueprint arrives the viewer lays out
+views of its own guessing.
 """
 
 from __future__ import annotations
 
 import rerun.blueprint as rrb
 
-from recordings.rerun_rows import EVENTS, TIMELINE, VELOCITY, WORLD, agv_path, velocity_path
+from recordings.rerun_fleet import ARRIVED_PLOT, STATE_PLOT
+from recordings.rerun_rows import EVENTS, TIMELINE, WORLD, agv_path, velocity_path
 
-FLEET_PLOTS = (("speed", "|v| (m/s)"), ("omega", "ω (rad/s)"))
+FLEET_PLOTS = ((STATE_PLOT, "AGVs driving / waiting / stopped"), (ARRIVED_PLOT, "AGVs arrived"))
 AGV_PLOTS = (
-    *FLEET_PLOTS,
+    ("speed", "|v| (m/s)"),
+    ("omega", "ω (rad/s)"),
     ("vx", "vx (m/s, body frame: forward)"),
     ("vy", "vy (m/s, body frame: left)"),
 )
 FOLLOW_HALF_SIZE = (6.0, 4.0)  # m around the followed AGV
 MAP_MARGIN = 0.05  # of the map's larger side, around the fitted map
 LEGEND_ROOM = 0.3  # of the run's duration, after its end: where the legend goes
-MAX_AGV_TABS = 20  # beyond this a tab bar is no way to find an AGV; the fleet tab stays
 
 Bounds = tuple[float, float, float, float]
 
@@ -47,7 +52,7 @@ def blueprint(
     whole recording) makes the plots show the whole run and the viewer open paused
     at its start (playing at ``rate`` x real time, if given); ``follow`` (an AGV's
     name) opens on that AGV's tab."""
-    shown = [n for n in agv_names[:MAX_AGV_TABS] if n != follow]
+    shown = [n for n in agv_names if n != follow]
     if follow is not None:
         shown.insert(0, follow)
     tabs = [_fleet_tab(agv_names, map_bounds, end_time)]
@@ -83,11 +88,11 @@ def _fleet_tab(agv_names: list[str], map_bounds: Bounds | None, end_time: float 
     plots = [
         rrb.TimeSeriesView(
             name=title,
-            origin=f"/{VELOCITY}/{q}",
+            origin=f"/{path}",
             axis_x=_whole_run(end_time, LEGEND_ROOM),
-            plot_legend=rrb.PlotLegend("RightTop" if end_time else "LeftTop"),
+            plot_legend=_legend(end_time),
         )
-        for q, title in FLEET_PLOTS
+        for path, title in FLEET_PLOTS
     ]
     return rrb.Horizontal(
         rrb.Vertical(map_view, events, row_shares=[3, 1]),
@@ -110,12 +115,17 @@ def _agv_tab(name: str, agv_names: list[str], end_time: float | None):
         rrb.TimeSeriesView(
             name=f"{name} {title}",
             origin=f"/{velocity_path(q, name)}",
-            axis_x=_whole_run(end_time, 0.0),
-            plot_legend=rrb.PlotLegend(visible=False),
+            axis_x=_whole_run(end_time, LEGEND_ROOM),
+            plot_legend=_legend(end_time),
         )
         for q, title in AGV_PLOTS
     ]
     return rrb.Horizontal(follow, rrb.Vertical(*plots), column_shares=[3, 2], name=name)
+
+
+def _legend(end_time: float | None) -> rrb.PlotLegend:
+    """Beside the data: right of a whole run (its axis runs past the end), left while live."""
+    return rrb.PlotLegend("RightTop" if end_time else "LeftTop")
 
 
 def _time_panel(end_time: float | None, rate: float | None) -> rrb.TimePanel:

@@ -16,8 +16,9 @@ import rerun as rr
 
 from bridge import keys
 from planner.core.motion import CONTROL_PERIOD
-from recordings.rerun_blueprint import blueprint
-from recordings.rerun_rows import TIMELINE, Row, RowMaker
+from recordings.rerun_blueprint import Bounds, blueprint
+from recordings.rerun_fleet import fleet_rows, fleet_style_rows
+from recordings.rerun_rows import AGV_ROW_TOPICS, TIMELINE, Row, RowMaker, map_bounds
 
 LIVE_PERIOD = 0.1  # s of wall time between sends of a live view
 
@@ -62,36 +63,69 @@ def _nanoseconds(seconds: list[float]) -> np.ndarray:
     return np.round(np.asarray(seconds) * 1e9).astype(np.int64).astype("timedelta64[ns]")
 
 
+def rows_of(maker: RowMaker, topic: str, data: dict) -> list[Row]:
+    """The rows of one message: its own, and the fleet's counts at a tick."""
+    rows = maker.feed(topic, data)
+    if topic == keys.WORLD_TICK:
+        rows += fleet_rows(data)
+    return rows
+
+
+def layout_of(messages) -> tuple[list[str], Bounds | None, float]:
+    """The AGVs (in the order the rows meet them), the map's bounds and the end time of
+    a whole recording, read from a few messages: what its blueprint needs, known before
+    any row is made."""
+    names: list[str] = []
+    bounds, ticked = None, False
+    for m in messages:
+        if m.topic == keys.WORLD_TICK:
+            if not ticked:
+                ticked = True
+                names += [s["name"] for s in m.data["agvs"] if s["name"] not in names]
+        elif m.topic == keys.WORLD_MAP:
+            bounds = map_bounds(m.data)
+        else:
+            name = keys.agv_name(m.topic)
+            if name is not None and name not in names and m.topic.endswith(AGV_ROW_TOPICS):
+                names.append(name)
+    end_time = next((m.data["time"] for m in reversed(messages) if m.topic == keys.WORLD_TICK), 0)
+    return names, bounds, end_time
+
+
 def send_recording(stream: rr.RecordingStream, messages, follow=None, rate=None) -> None:
-    """Convert a whole recording and send it, with its blueprint (options: see
-    ``rerun_blueprint.blueprint``)."""
+    """Send a whole recording's blueprint (options: see ``rerun_blueprint.blueprint``),
+    then the recording converted."""
+    names, bounds, end_time = layout_of(messages)
+    stream.send_blueprint(blueprint(names, bounds, end_time, follow=follow, rate=rate))
     maker = RowMaker(recording_dt(messages))
     columns = Columns(stream)
+    columns.add(fleet_style_rows())
     for m in messages:
-        columns.add(maker.feed(m.topic, m.data))
+        columns.add(rows_of(maker, m.topic, m.data))
     columns.send()
-    stream.send_blueprint(
-        blueprint(maker.agv_names, maker.map_bounds, maker.end_time, follow=follow, rate=rate)
-    )
 
 
 class Live:
-    """Messages as they come: sent every ``LIVE_PERIOD``, the blueprint (re)sent when
-    an AGV appears. ``send()`` sends what is waiting (call it at the end)."""
+    """Messages as they come: sent every ``LIVE_PERIOD``, the blueprint (re)sent, before
+    the rows, when the map or an AGV appears. ``send()`` sends what is waiting (call it
+    at the end)."""
 
     def __init__(self, stream: rr.RecordingStream, dt: float):
         self._stream = stream
         self._maker = RowMaker(dt)
         self._columns = Columns(stream)
-        self._agvs_shown = 0
+        self._shown: tuple | None = None  # (AGVs, map bounds) of the blueprint sent
         self._due = time.monotonic() + LIVE_PERIOD
 
     def feed(self, topic: str, data: dict) -> None:
-        self._columns.add(self._maker.feed(topic, data))
-        names = self._maker.agv_names
-        if len(names) != self._agvs_shown:
-            self._agvs_shown = len(names)
-            self._stream.send_blueprint(blueprint(names, self._maker.map_bounds))
+        rows = rows_of(self._maker, topic, data)
+        shown = (len(self._maker.agv_names), self._maker.map_bounds)
+        if shown != self._shown:
+            self._stream.send_blueprint(blueprint(self._maker.agv_names, shown[1]))
+            if self._shown is None:
+                self._columns.add(fleet_style_rows())
+            self._shown = shown
+        self._columns.add(rows)
         if time.monotonic() >= self._due:
             self.send()
 

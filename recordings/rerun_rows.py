@@ -32,6 +32,8 @@ Entity paths (everything on the map under ``world``, in world coordinates):
                                   arrived, failed, collision, end, wait, go, yield, ...; and
                                   from the plans: replan, no path)
     velocity/<q>/<name>           Scalars, q in vx, vy (body frame), speed (|v|), omega
+
+Beside them ``recordings.rerun_fleet`` makes ``fleet/...``: the fleet's counts per tick.
 """
 
 from __future__ import annotations
@@ -73,6 +75,16 @@ LEVELS = {COLLISION: "WARN", FAILED: "ERROR", NO_PATH: "WARN", RECOVERY: "WARN"}
 WAITING_RING = 1.6  # x radius: the ring shows round the body
 HEADING_LENGTH = 2.0  # x radius: the heading line sticks out of the disc, visible when small
 LABEL_GAP = 1.0  # m right of the disc's rim: the name (centred on its anchor) never covers it
+
+
+_AGV_HANDLERS = {  # the end of an AGV's key -> the RowMaker method that makes its rows
+    "/command": "_state",
+    "/state": "_state",  # recordings before the world integrated commands
+    "/plan": "_plan",
+    "/trajectory": "_trajectory",
+}
+AGV_ROW_TOPICS = tuple(_AGV_HANDLERS)
+"""The ends of the AGV keys that make rows."""
 
 
 class Row(NamedTuple):
@@ -154,15 +166,10 @@ class RowMaker:
             self._event(data, rows)
         else:
             name = keys.agv_name(topic)
-            handler = {
-                "command": self._state,
-                "state": self._state,  # recordings before the world integrated commands
-                "plan": self._plan,
-                "trajectory": self._trajectory,
-            }.get(topic.rsplit("/", 1)[-1])
-            if name is not None and handler is not None:
+            method = _AGV_HANDLERS.get(topic[topic.rfind("/") :])
+            if name is not None and method is not None:
                 self._meet(name, rows)
-                handler(name, data, rows)
+                getattr(self, method)(name, data, rows)
 
     def _time(self, tick: int) -> float:
         return round(tick * self.dt, 9)
@@ -174,8 +181,8 @@ class RowMaker:
         self._map_msg = data
         res = self._resolution = data["resolution"]
         x0, y0 = self._origin = map_origin(data)
-        w, h = map_size(data)
-        self.map_bounds = (x0, y0, x0 + w, y0 + h)
+        h = map_size(data)[1]
+        self.map_bounds = map_bounds(data)
         cells = np.frombuffer("".join(data["rows"]).encode(), dtype=np.uint8)
         blocked = cells.reshape(data["height"], data["width"]) == ord("#")
         shades = np.where(blocked, BLOCKED_SHADE, FREE_SHADE).astype(np.uint8)
@@ -323,6 +330,13 @@ class RowMaker:
         if detail and detail != kind:
             text += f": {detail}"
         rows.append(Row(event_path(kind), kinds.text, t, (text, LEVELS.get(kind, "INFO"))))
+
+
+def map_bounds(map_data: dict) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) in m of a ``world/map`` message (dict form)."""
+    x0, y0 = map_origin(map_data)
+    w, h = map_size(map_data)
+    return (x0, y0, x0 + w, y0 + h)
 
 
 def _passages(map_msg: dict, radius: float) -> Row:

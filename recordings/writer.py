@@ -40,9 +40,8 @@ from pathlib import Path
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
-from bridge.keys import message_type
-from bridge.messages import encode, json_schema
-from recordings import foxglove
+from bridge.messages import encode
+from recordings.channels import MESSAGE_ENCODING, SCHEMA_ENCODING, ChannelMessages, channel_schema
 
 CHUNK_BYTES = 256 * 1024
 """Uncompressed bytes per chunk: ~1000 AGV states, a few ms of a fast run."""
@@ -82,8 +81,8 @@ class RecordingWriter:
         self._mcap = Writer(self._file, chunk_size=_NEVER, compression=CompressionType.ZSTD)
         self._mcap.start(library=f"agv-fleet/{tool_version()} {LIBRARY_IDENTIFIER}")
         self._channels: dict[str, int] = {}
-        self._schemas: dict[object, int] = {}  # message class or foxglove schema name
-        self._foxglove = foxglove.FoxgloveChannels()
+        self._schemas: dict[str, int] = {}  # schema name -> id
+        self._outbox = ChannelMessages()
         self._pending = 0
         self._due = time.monotonic() + CHUNK_SECONDS
         self._closed = False
@@ -122,14 +121,8 @@ class RecordingWriter:
         """Record JSON bytes as they came from the bus (not checked), at the run's
         start + ``sim_time_ns``, and what Foxglove needs of them."""
         log_time = self.log_time_zero_ns + sim_time_ns
-        self._add(key, payload, log_time)
-        if self._foxglove.wants(key):
-            try:
-                made = self._foxglove.feed(key, json.loads(payload), log_time)
-            except (ValueError, KeyError, TypeError, IndexError):
-                made = []  # not a message of its type: recorded as it came, nothing drawn
-            for topic, message in made:
-                self._add(topic, foxglove.encode(message), log_time)
+        for topic, data in self._outbox.of(key, payload, log_time):
+            self._add(topic, data, log_time)
         if self._pending >= CHUNK_BYTES or time.monotonic() >= self._due:
             self._close_chunk()
 
@@ -163,21 +156,15 @@ class RecordingWriter:
             self._file.close()
 
     def _register(self, key: str) -> int:
-        cls = message_type(key)
         schema = 0
-        if cls is not None:
-            schema = self._schemas.get(cls, 0)
-            if not schema:
-                data = json.dumps(json_schema(cls), separators=(",", ":")).encode()
-                schema = self._mcap.register_schema(cls.__name__, "jsonschema", data)
-                self._schemas[cls] = schema
-        elif key in foxglove.SCHEMA_OF:
-            name = foxglove.SCHEMA_OF[key]
+        known = channel_schema(key)
+        if known is not None:
+            name, data = known
             schema = self._schemas.get(name, 0)
             if not schema:
-                schema = self._mcap.register_schema(name, "jsonschema", foxglove.schema(name))
+                schema = self._mcap.register_schema(name, SCHEMA_ENCODING, data)
                 self._schemas[name] = schema
-        channel = self._mcap.register_channel(key, "json", schema)
+        channel = self._mcap.register_channel(key, MESSAGE_ENCODING, schema)
         self._channels[key] = channel
         return channel
 

@@ -283,19 +283,12 @@ def test_ros_map_image_path_may_be_absolute(tmp_path):
         (b"P2\n2 1\n100\n0 101", r"pixel value 101 exceeds maxval 100"),
         (b"P5\n4 x\n255\n" + bytes(12), r"bad PGM header"),
         (b"P5\n0 3\n255\n", r"bad PGM header: size 0x3"),
-        (b"\x89PNG\r\n\x1a\n" + bytes(20), r"not a PGM file"),
     ],
 )
 def test_bad_pgm(tmp_path, pgm, problem):
     (tmp_path / "map.pgm").write_bytes(pgm)
     with pytest.raises(MapError, match=r"map\.pgm: " + problem):
         load_map(write_yaml(tmp_path / "m.yaml"))
-
-
-def test_ros_map_only_reads_pgm(tmp_path):
-    (tmp_path / "map.png").write_bytes(b"\x89PNG\r\n\x1a\n")
-    with pytest.raises(MapError, match=r"map\.png: only PGM map images are supported, not '\.png'"):
-        load_map(write_yaml(tmp_path / "m.yaml", image="map.png"))
 
 
 @pytest.mark.parametrize(

@@ -155,7 +155,7 @@ def test_margin_key_and_safety_distance_come_from_one_place():
 def test_a_start_where_the_body_does_not_fit_is_refused(tmp_path):
     path = _ros_map(tmp_path, np.full((10, 10), FREE), origin="[-2.0, -2.0, 0.0]")
     text = f'[map]\nfile = "{path}"\n[[agvs]]\nname = "a"\nstart = [-1.8, 0.0]\ngoal = [2.5, 2.5]\n'
-    with pytest.raises(ScenarioError, match=r"start \(-1.8, 0\) is 0.200 m from an obstacle"):
+    with pytest.raises(ScenarioError, match=r"start \(-1.8, 0\) is 0.2000 m from an obstacle"):
         parse_scenario(text)
     ok = parse_scenario(text.replace("-1.8, 0.0", "-1.0, 0.0"))
     assert ok.grid.origin == (-2.0, -2.0)

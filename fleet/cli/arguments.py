@@ -31,3 +31,39 @@ def non_negative_float(text: str) -> float:
     if not (0 <= value < float("inf")):
         raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text}")
     return value
+
+
+FOXGLOVE_PORT = 8765
+"""Foxglove's default WebSocket port: ``--foxglove`` without a number."""
+
+
+def tcp_port(text: str) -> int:
+    """An argparse type: a TCP port, 0 for one the OS picks."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a port number: {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"not a TCP port: {text}")
+    return value
+
+
+def add_foxglove_options(parser: argparse.ArgumentParser, what: str) -> None:
+    """``--foxglove [PORT]`` and ``--foxglove-host``, for ``run`` and ``replay``."""
+    parser.add_argument(
+        "--foxglove",
+        nargs="?",
+        type=tcp_port,
+        const=FOXGLOVE_PORT,
+        metavar="PORT",
+        help=(
+            f"serve {what} over the Foxglove WebSocket protocol (foxglove.websocket.v1) on "
+            f"PORT (default {FOXGLOVE_PORT}; 0: a free port), kept up after it until Ctrl-C"
+        ),
+    )
+    parser.add_argument(
+        "--foxglove-host",
+        default="127.0.0.1",
+        metavar="HOST",
+        help="with --foxglove: the address to listen on (default 127.0.0.1)",
+    )

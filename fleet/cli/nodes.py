@@ -122,6 +122,8 @@ def add_parsers(sub) -> None:
         metavar="S",
         help=f"give up when no router answers within S seconds (default {CONNECT_TIMEOUT_S:g})",
     )
+    # the launcher's pipe for "an AGV process ended abnormally" (fleet.runtime.agv_host)
+    a.add_argument("--exits-fd", type=int, help=argparse.SUPPRESS)
     a.set_defaults(handler=run_agv)
 
     r = sub.add_parser(
@@ -202,6 +204,7 @@ def run_agv(args: argparse.Namespace) -> int:
         zenoh_config=args.zenoh_config,
         logins=logins,
         grace=args.grace,
+        exits_fd=args.exits_fd,
     )
 
 

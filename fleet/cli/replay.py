@@ -1,4 +1,5 @@
-"""``agv-fleet replay``: show a recording in Rerun (native viewer, an .rrd file, the web viewer)."""
+"""``agv-fleet replay``: show a recording in Rerun (native viewer, an .rrd file, the web
+viewer) or serve it to Foxglove."""
 
 from __future__ import annotations
 
@@ -6,7 +7,7 @@ import argparse
 import sys
 
 from fleet import exit_codes
-from fleet.cli.arguments import UsageError, positive_float
+from fleet.cli.arguments import UsageError, add_foxglove_options, positive_float
 from fleet.runtime.interrupts import interrupts_raised
 from recordings.reader import RecordingError, open_recording
 from recordings.rerun_server import require_display
@@ -43,8 +44,9 @@ def add_parsers(sub) -> None:
         type=positive_float,
         metavar="F",
         help="open the viewer or web viewer playing at F x real time (default: paused at the "
-        "start of the run)",
+        "start of the run; with --foxglove: sent at F x real time, default 1)",
     )
+    add_foxglove_options(p, "the recording")
     p.set_defaults(handler=replay)
 
 
@@ -53,8 +55,12 @@ def replay(args: argparse.Namespace) -> int:
     # included, would import it at start-up
     from recordings.rerun_view import save_rrd, serve_web, spawn_viewer
 
-    viewer = not (args.save or args.web)
-    if args.rate and not (viewer or args.web):
+    viewer = not (args.save or args.web or args.foxglove is not None)
+    if args.foxglove is None and args.foxglove_host != "127.0.0.1":
+        raise UsageError("--foxglove-host goes with --foxglove")
+    if args.foxglove is not None and (args.save or args.web):
+        raise UsageError("--foxglove serves the recording by itself: not with --save or --web")
+    if args.rate and not (viewer or args.web or args.foxglove is not None):
         raise UsageError("--rate plays the viewer or --web, not --save")
     if args.port and not args.web:
         raise UsageError("--port is the web viewer's: add --web")
@@ -80,7 +86,13 @@ def replay(args: argparse.Namespace) -> int:
         save_rrd(recording, args.save, follow=args.follow)
         print(f"agv-fleet replay: wrote {args.save}", file=sys.stderr)
     with interrupts_raised():
-        if args.web:
+        if args.foxglove is not None:
+            from recordings.foxglove_live import serve_recording
+
+            serve_recording(
+                recording, rate=args.rate or 1.0, host=args.foxglove_host, port=args.foxglove
+            )
+        elif args.web:
             serve_web(recording, rate=args.rate, follow=args.follow, port=args.port)
         elif viewer:
             spawn_viewer(recording, rate=args.rate, follow=args.follow)

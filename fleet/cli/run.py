@@ -10,10 +10,16 @@ from contextlib import ExitStack
 from pathlib import Path
 
 from fleet import exit_codes
-from fleet.cli.arguments import UsageError, non_negative_float, positive_float
+from fleet.cli.arguments import (
+    UsageError,
+    add_foxglove_options,
+    non_negative_float,
+    positive_float,
+)
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.runtime.interrupts import interrupts_raised
 from fleet.runtime.launcher import FleetOptions, RecordingLost, run_fleet
+from fleet.runtime.lockstep import tee
 from fleet.runtime.progress import Progress
 from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
@@ -114,6 +120,7 @@ def add_parsers(sub) -> None:
         action="store_true",
         help="with --rerun: serve the web viewer on 127.0.0.1 (kept up after the run until Ctrl-C)",
     )
+    add_foxglove_options(p, "the run live")
     p.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run)
@@ -132,6 +139,8 @@ def run(args: argparse.Namespace) -> int:
         record_path = Path(args.output) if args.output else default_recording_path(scenario.name)
     if (args.rerun_save or args.rerun_web) and not args.rerun:
         raise UsageError("--rerun-save and --rerun-web go with --rerun")
+    if args.foxglove is None and args.foxglove_host != "127.0.0.1":
+        raise UsageError("--foxglove-host goes with --foxglove")
     watch = _Watch(None if args.quiet else Progress(scenario))
     with ExitStack() as stack:
         try:
@@ -145,7 +154,16 @@ def run(args: argparse.Namespace) -> int:
                 view = stack.enter_context(
                     LiveView(scenario.dt, save=args.rerun_save, web=args.rerun_web)
                 )
-            summary = _run(args, scenario, record_path, watch, view)
+            foxglove = None
+            if args.foxglove is not None:
+                from recordings.foxglove_live import FoxgloveLive
+
+                foxglove = stack.enter_context(
+                    FoxgloveLive(scenario.dt, host=args.foxglove_host, port=args.foxglove)
+                )
+            taps = [t for t in (view, foxglove) if t is not None]
+            tap = tee(*taps) if len(taps) > 1 else (taps[0] if taps else None)
+            summary = _run(args, scenario, record_path, watch, tap)
         except RerunError as err:  # its hints name replay's flags: say run's
             hint = str(err).replace("--save", "--rerun-save").replace("--web", "--rerun-web")
             raise RerunError(hint) from None
@@ -160,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
         _report(args, summary, record_path)
         if view is not None and args.rerun_web:
             view.hold()
+        if foxglove is not None:
+            foxglove.hold()
     return exit_codes.OK if summary.success else exit_codes.NOT_SUCCEEDED
 
 

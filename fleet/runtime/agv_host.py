@@ -41,13 +41,15 @@ def serve_agvs(
     zenoh_config: str | None = None,
     logins: dict[str, Login] | None = None,
     grace: float = DEFAULT_GRACE_S,
+    exits_fd: int | None = None,
 ) -> int:
     """Run every named AGV, each in its own process (logged in as ``logins[name]``
-    when given); the worst exit status."""
+    when given); the worst exit status. ``exits_fd``: a pipe to the launcher, told at
+    once of every AGV process that ends abnormally (see ``tell_exit``)."""
     AgvNode(scenario, names[0]).warm_up()
     logins = logins or {}
     options = (connect, prefix, connect_timeout, zenoh_config, grace)
-    if len(names) == 1:
+    if len(names) == 1 and exits_fd is None:  # nobody to tell: this process is the AGV
         _set_title(process_title(names[0]))
         return _serve_one(scenario, names[0], *options, logins.get(names[0]))
     children: dict[int, str] = {}
@@ -67,7 +69,7 @@ def serve_agvs(
                 os._exit(code)
         children[pid] = name
     _set_title(f"agv-fleet agv-host {scenario.name} ({len(names)} AGVs)")
-    return _wait_for(children)
+    return _wait_for(children, exits_fd)
 
 
 def _set_title(title: str) -> None:
@@ -94,7 +96,21 @@ def _serve_one(scenario, name, connect, prefix, connect_timeout, zenoh_config, g
     return exit_codes.OK
 
 
-def _wait_for(children: dict[int, str]) -> int:
+def exit_reason(code: int) -> str:
+    """How a process ended, from its exit code (negative: the signal that killed it)."""
+    return f"killed by signal {-code}" if code < 0 else f"ended with status {code}"
+
+
+def tell_exit(exits_fd: int | None, name: str, code: int) -> None:
+    """Write "NAME<TAB>why" on the launcher's pipe (``WorldServer`` fails the AGV at once,
+    rather than when its liveliness lease and the grace period have run out)."""
+    if exits_fd is None:
+        return
+    with contextlib.suppress(OSError):  # the launcher is gone: nobody to tell
+        os.write(exits_fd, f"{name}\t{exit_reason(code)}\n".encode())
+
+
+def _wait_for(children: dict[int, str], exits_fd: int | None = None) -> int:
     """Wait for every child; on SIGTERM or Ctrl-C end them all by PID first."""
 
     ending = []
@@ -115,8 +131,10 @@ def _wait_for(children: dict[int, str]) -> int:
             break
         name = children.pop(pid, None)
         code = os.waitstatus_to_exitcode(status)
+        if code != 0 and not ending:
+            tell_exit(exits_fd, name, code)
         if code < 0 and not ending:
-            say(f"agv-fleet agv {name}: killed by signal {-code}")
+            say(f"agv-fleet agv {name}: {exit_reason(code)}")
         worst = max(worst, 128 - code if code < 0 else code)
     return worst
 

@@ -57,6 +57,7 @@ class AgvNode:
         self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
         self.guard = traffic_guard(scenario, self.controller)
         self._parked: frozenset[str] = frozenset()
+        self._stopped_at: dict[str, float] = {}  # sim time each other AGV stopped for good
         self._started = False
         self._index = 0  # where this AGV's state was in the last tick's list
 
@@ -145,9 +146,15 @@ class AgvNode:
         if names != self._parked:
             self._parked = names
             discs = [(s.x, s.y, s.radius) for s in parked]
-            self.controller.park(discs)
+            self.controller.park(discs, [self._stopped_label(s, tick.time) for s in parked])
             if self.guard is not None:
                 self.guard.park(discs)
+
+    def _stopped_label(self, state, now: float) -> str:
+        """'AGV 'b', failed at t = 0.1 s (killed by signal 9)': who stands where, since when."""
+        since = self._stopped_at.setdefault(state.name, now)
+        why = f" ({state.failure})" if state.failure else ""
+        return f"AGV '{state.name}', {state.status} at t = {since:.1f} s{why}"
 
     def _sense(self, tick: Tick, pose) -> None:
         if not tick.temporary:

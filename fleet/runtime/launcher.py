@@ -16,10 +16,12 @@ find through an environment variable, and that is removed at the end.
 from __future__ import annotations
 
 import os
+import queue
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable
 from contextlib import contextmanager
@@ -101,9 +103,10 @@ def run_fleet(
         try:
             names = [agv.name for agv in scenario.agvs]
             guard, child_files = write_run_credentials(run_dir, names, prefix)
-            children.append(
-                _spawn(agv_command(options, names, endpoint, prefix), child_files["agvs"])
-            )
+            exits = AgvExits()
+            command = [*agv_command(options, names, endpoint, prefix), "--exits-fd", exits.fd]
+            children.append(_spawn(command, child_files["agvs"], pass_fds=(int(exits.fd),)))
+            exits.start()
             recorder, ended = None, {}
             if options.record_path:
                 recorder = _spawn(
@@ -125,6 +128,7 @@ def run_fleet(
                     abort_check=lambda: _exited_early(children),
                     recorder=options.record_path is not None,
                     say_waiting=options.say_waiting,
+                    exits=exits.queue,
                 )
                 summary = server.run()
                 if progress:
@@ -199,11 +203,35 @@ def _exited_early(children: list[subprocess.Popen]) -> str | None:
     return None
 
 
-def _spawn(cmd: list[str], credentials_file: str) -> subprocess.Popen:
+class AgvExits:
+    """The pipe on which the AGV host tells which AGV process ended abnormally and how
+    (``agv_host.tell_exit``), read by a thread into ``queue`` as (name, why)."""
+
+    def __init__(self):
+        self._read, write = os.pipe()
+        self.fd = str(write)
+        self.queue: queue.Queue[tuple[str, str]] = queue.Queue()
+
+    def start(self) -> None:
+        """After the host has its copy of the write end: close ours and read."""
+        os.close(int(self.fd))
+        threading.Thread(target=self._pump, daemon=True).start()
+
+    def _pump(self) -> None:
+        with os.fdopen(self._read, "r", errors="replace") as lines:
+            for line in lines:
+                name, _, why = line.rstrip("\n").partition("\t")
+                if name and why:
+                    self.queue.put((name, why))
+
+
+def _spawn(cmd: list[str], credentials_file: str, pass_fds=()) -> subprocess.Popen:
     # own process group: a Ctrl-C in the terminal reaches only the launcher, which
     # ends the children itself, in order
     env = {**os.environ, CREDENTIALS_ENV: credentials_file}
-    return subprocess.Popen(cmd, stdin=subprocess.DEVNULL, start_new_session=True, env=env)
+    return subprocess.Popen(
+        cmd, stdin=subprocess.DEVNULL, start_new_session=True, env=env, pass_fds=pass_fds
+    )
 
 
 @contextmanager

@@ -209,6 +209,7 @@ class World:
         state = self.states[name]
         state.vx = state.vy = state.omega = 0.0
         state.status = FAILED
+        state.failure = why  # in the ticks too: an AGV it stops names it
         self.intents.pop(name, None)
         self._finish(name, FAILED, why)
 

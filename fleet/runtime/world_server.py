@@ -59,6 +59,7 @@ class WorldServer:
         abort_check: Callable[[], str | None] | None = None,
         recorder: bool = False,
         say_waiting: bool = False,
+        exits: queue.Queue | None = None,
     ):
         self.scenario = scenario
         self.bus = bus
@@ -69,6 +70,7 @@ class WorldServer:
         self.realtime = realtime
         self.progress = progress
         self.abort_check = abort_check
+        self.exits = exits  # (AGV, why) of AGV processes seen ending (launcher.AgvExits)
         self.world = World(scenario)
         self.alive: set[str] = set()
         self._lost: dict[str, float] = {}  # AGV -> when it was lost (monotonic)
@@ -142,6 +144,11 @@ class WorldServer:
             self.world.mark_failed(name, f"did not come up within {self.start_timeout:g} s")
 
     def _update_liveliness(self, timeout: float = 0.0) -> None:
+        while self.exits is not None and not self.exits.empty():
+            name, why = self.exits.get_nowait()
+            if name in self.world.live_agvs():  # its host saw it end: no lease to wait out
+                self.world.mark_failed(name, why)
+                self._lost.pop(name, None)
         try:
             while True:
                 key, is_alive = self._liveliness.get(timeout=timeout)

@@ -27,6 +27,20 @@ CLEARANCE_CAP = 2.0
 """m, the most clearance that counts: DWA's dist term credits no more (farther from every
 obstacle is no safer), and a route's clearance is measured up to it."""
 
+TOLERANCE = 1e-9
+"""m: how far a distance may fall short of what an AGV needs and still meet it.
+
+Distances are measured in cells and turned into metres, and radii turned into cells: each
+conversion rounds (0.11 / 0.05 * 0.05 is 0.10999999999999999), so an exact comparison
+refused a 0.11 m AGV exactly 0.11 m from a wall. A nanometre is far above that rounding
+(~1e-16 of the value) and far below anything a map or a controller can tell apart."""
+
+
+def keeps(distance, needed):
+    """Whether ``distance`` is at least ``needed`` (m; numbers or numpy arrays), up to
+    float rounding (:data:`TOLERANCE`): the one comparison of a clearance with a radius."""
+    return distance >= needed - TOLERANCE
+
 
 class ClearanceError(BadInputError, ValueError):
     """Radius, margin and safety distance that do not fit together."""
@@ -62,7 +76,7 @@ class Clearance:
     def from_safety_distance(cls, radius: float, safety_distance: float) -> Clearance:
         """The clearance whose safety distance is ``safety_distance``; below the radius
         it is an error (the AGV's body would be allowed to touch obstacles)."""
-        if safety_distance < radius - 1e-12:
+        if not keeps(safety_distance, radius):
             raise ClearanceError(
                 f"safety distance {safety_distance:g} m is below the AGV radius {radius:g} m: "
                 "the AGV's body would touch obstacles (the safety distance is radius + margin; "

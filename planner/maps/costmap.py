@@ -5,8 +5,9 @@ For every cell, ``distance`` is the exact Euclidean distance from the cell's cen
 the nearest obstacle *square* (its edges, not its centre) or to the map's border
 (outside the map counts as obstacle). Then, for an AGV of radius r and margin m:
 
-- lethal: distance < r. An AGV centred there would overlap an obstacle (Nav2's
-  "inscribed" cost, lethal for a round robot). Obstacle cells have distance 0.
+- lethal: distance < r (up to float rounding, ``clearance.keeps``). An AGV centred
+  there would overlap an obstacle (Nav2's "inscribed" cost, lethal for a round robot).
+  Obstacle cells have distance 0.
 - penalty: a cost that decays linearly from ``COST_WEIGHT`` at distance r to 0 at
   r + m (Nav2 decays exponentially out to its inflation radius). A search step into a
   cell costs its length times (1 + penalty), so routes keep off walls where there is
@@ -33,7 +34,7 @@ import numba
 import numpy as np
 
 from planner.core.errors import MapError
-from planner.maps.clearance import Clearance
+from planner.maps.clearance import Clearance, keeps
 from planner.maps.distance_field import edt_1d
 from planner.maps.grid import Cell, GridMap, Point
 from planner.maps.segment_clearance import route_clearance
@@ -106,15 +107,16 @@ class Costmap:
 
 def point_clearance(grid: GridMap, point: Point, cap: float) -> float:
     """Exact distance (m) from a world point to the nearest obstacle square or the map's
-    edge, or ``cap`` if it is farther."""
-    return route_clearance(grid.blocked, [grid.to_cell_units(point)], cap / grid.resolution) * (
-        grid.resolution
-    )
+    edge, or ``cap`` itself if it is farther (not ``cap`` turned into cells and back,
+    which can round below it)."""
+    cap_cells = cap / grid.resolution
+    cells = route_clearance(grid.blocked, [grid.to_cell_units(point)], cap_cells)
+    return cap if cells >= cap_cells else cells * grid.resolution
 
 
 def _costs(distance: np.ndarray, clearance: Clearance) -> tuple[np.ndarray, np.ndarray]:
     radius, margin = clearance.radius, clearance.margin
-    lethal = distance < radius
+    lethal = ~keeps(distance, radius)
     if margin > 0:
         penalty = COST_WEIGHT * np.clip((radius + margin - distance) / margin, 0.0, 1.0)
     else:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -12,9 +11,9 @@ import numpy as np
 import yaml
 
 from planner.core.errors import MapError
-from planner.core.limits import check_map_cells
 from planner.maps.grid import GridMap
-from planner.maps.map_files import read_bytes, read_text
+from planner.maps.map_files import read_text
+from planner.maps.map_image import MapImage, read_map_image
 
 ROS_MODES = ("trinary", "scale", "raw")
 
@@ -81,74 +80,40 @@ def read_ros_map_info(yaml_path: str | os.PathLike) -> RosMapInfo:
     return RosMapInfo(image, resolution, origin, occupied, free, bool(doc["negate"]), mode)
 
 
-_PGM_SEP = rb"(?:\s|#[^\r\n]*[\r\n])+"  # whitespace and '#' comments between header fields
-_PGM_HEADER = re.compile(
-    rb"(P[25])" + _PGM_SEP + rb"(\d+)" + _PGM_SEP + rb"(\d+)" + _PGM_SEP + rb"(\d+)\s"
-)
-
-
-def _read_pgm(path: str | os.PathLike) -> tuple[np.ndarray, int]:
-    """(pixels, maxval) of a binary (P5, 8 or 16 bit) or plain (P2) PGM; top row first."""
-    path = Path(path)
-    if path.suffix.lower() != ".pgm":
-        raise MapError(
-            f"{path}: only PGM map images are supported, not {path.suffix or 'no extension'!r} "
-            "(convert it to .pgm)"
-        )
-    data = read_bytes(path, "map image")
-    match = _PGM_HEADER.match(data)
-    if match is None:
-        problem = "bad PGM header" if data[:2] in (b"P2", b"P5") else "not a PGM file (no P2/P5)"
-        raise MapError(f"{path}: {problem}")
-    magic, width, height, maxval = match[1], int(match[2]), int(match[3]), int(match[4])
-    if width == 0 or height == 0 or not 0 < maxval < 65536:
-        raise MapError(f"{path}: bad PGM header: size {width}x{height}, maxval {maxval}")
-    check_map_cells(width, height, str(path))
-    count = width * height
-    if magic == b"P5":
-        dtype = np.dtype("u1" if maxval < 256 else ">u2")
-        available = (len(data) - match.end()) // dtype.itemsize
-        if available < count:
-            raise MapError(f"{path}: truncated PGM: {available} of {count} pixels present")
-        pixels = np.frombuffer(data, dtype, count, match.end())
-    else:
-        tokens = data[match.end() :].split()
-        if len(tokens) < count:
-            raise MapError(f"{path}: truncated PGM: {len(tokens)} of {count} pixels present")
-        if not all(token.isdigit() for token in tokens[:count]):
-            raise MapError(f"{path}: plain PGM pixels must be non-negative integers")
-        pixels = np.array([int(token) for token in tokens[:count]], dtype=np.int64)
-    if pixels.max() > maxval:
-        raise MapError(f"{path}: pixel value {pixels.max()} exceeds maxval {maxval}")
-    return pixels.reshape(height, width), maxval
-
-
 OCC_FREE, OCC_OCCUPIED, OCC_UNKNOWN = 0, 100, -1  # nav_msgs/OccupancyGrid values
 
 
-def ros_occupancy(pixels: np.ndarray, maxval: int, info: RosMapInfo) -> np.ndarray:
-    """The nav_msgs/OccupancyGrid values map_server publishes for these pixels (top row
+def ros_occupancy(image: MapImage, info: RosMapInfo) -> np.ndarray:
+    """The nav_msgs/OccupancyGrid values map_server publishes for this image (top row
     first): 0 free, 100 occupied, -1 unknown, 1-99 partly occupied (nav2_map_server's
     ``loadMapFromFile``).
 
-    shade = pixel / maxval; occupancy p = 1 - shade (shade if ``negate``).
-    trinary: p > occupied_thresh occupied, p < free_thresh free, anything between unknown.
-    scale: the same, but between the thresholds p is scaled linearly to 1-99 (a PGM has no
-    alpha channel, so nothing is unknown). raw: the value is round(shade * 255) - the
-    occupancy in percent, ``negate`` not applied, as map_server does - and above 100 unknown.
+    shade = the mean of the pixel's red, green and blue, and in trinary mode of its alpha
+    too when the image has one, over their maximum; occupancy p = 1 - shade (shade if
+    ``negate``). trinary: p > occupied_thresh occupied, p < free_thresh free, anything
+    between unknown. scale: a pixel not fully opaque is unknown; otherwise the same, but
+    between the thresholds p is scaled linearly to 1-99. raw: the value is
+    round(shade * 255) - the occupancy in percent, ``negate`` not applied, as map_server
+    does - and above 100 unknown.
     """
-    shade = pixels / maxval
+    with_alpha = info.mode == "trinary" and image.alpha is not None
+    if with_alpha:
+        shade = (image.colour_sum + image.alpha) / 4 / image.maxval
+    else:
+        shade = image.colour_sum / 3 / image.maxval
     if info.mode == "raw":
         percent = np.rint(shade * 255).astype(np.int16)
         return np.where(percent <= OCC_OCCUPIED, percent, OCC_UNKNOWN).astype(np.int8)
     occ = shade if info.negate else 1.0 - shade
-    out = np.full(pixels.shape, OCC_UNKNOWN, dtype=np.int8)
+    out = np.full(shade.shape, OCC_UNKNOWN, dtype=np.int8)
     if info.mode == "scale":
         span = max(info.occupied_thresh - info.free_thresh, 1e-12)
         between = np.rint((occ - info.free_thresh) / span * 100.0)
         out = np.clip(between, 1, 99).astype(np.int8)
     out[occ > info.occupied_thresh] = OCC_OCCUPIED
     out[occ < info.free_thresh] = OCC_FREE
+    if info.mode == "scale" and image.alpha is not None:
+        out[image.alpha != image.maxval] = OCC_UNKNOWN
     return out
 
 
@@ -189,8 +154,9 @@ def check_yaw(info: RosMapInfo, path: Path) -> None:
 def load_ros_map(
     yaml_path: str | os.PathLike, resolution: float | None = None, unknown: str = "obstacle"
 ) -> GridMap:
-    """A ROS map_server map (YAML + PGM) in its ``map`` frame: the YAML's origin (x, y) is
-    the GridMap's origin, and its resolution is used unless one is given. ``unknown``:
+    """A ROS map_server map (YAML + image: PGM, PNG, ...) in its ``map`` frame: the
+    YAML's origin (x, y) is the GridMap's origin, and its resolution is used unless one is
+    given. ``unknown``:
     whether unknown cells are obstacles (default) or free (see :func:`ros_blocked`).
     """
     path = Path(yaml_path)
@@ -202,8 +168,7 @@ def load_ros_map(
         )
     if not info.image.is_file():
         raise MapError(f"{path}: map image not found: {info.image}")
-    pixels, maxval = _read_pgm(info.image)
-    blocked = ros_blocked(ros_occupancy(pixels, maxval, info), info, unknown)
+    blocked = ros_blocked(ros_occupancy(read_map_image(info.image), info), info, unknown)
     res = info.resolution if resolution is None else resolution
     try:
         return GridMap.from_rows_top_down(blocked, res, path.stem, info.origin[:2])

@@ -145,7 +145,8 @@ class FusionController:
         plan = self.plans.plan(position, moving)
         self.failure = self.plans.take_map_error() or self.failure
         if not plan.found:
-            parked = " and the AGVs stopped for good" if self.plans.parked else ""
+            who = "; ".join(label for _, _, label in self.plans.parked_by)
+            parked = f" and the AGVs stopped for good ({who})" if self.plans.parked else ""
             self.failure = self.failure or f"no path to the goal on the known map{parked}"
             self.mode = Mode.FAILED
             self.key_nodes.drop()
@@ -172,10 +173,11 @@ class FusionController:
             self.dwa.distance_field = self.plans.field
         return new
 
-    def park(self, discs) -> None:
+    def park(self, discs, labels=()) -> None:
         """AGVs that stopped for good (arrived, failed) at (x, y, radius): obstacles for
-        every later global plan (DWA sees them as discs anyway)."""
-        self.plans.park(discs, self.key_nodes.route_ahead() if self.targets else None)
+        every later global plan (DWA sees them as discs anyway); ``labels`` name them in a
+        failure they cause."""
+        self.plans.park(discs, self.key_nodes.route_ahead() if self.targets else None, labels)
 
     def stalled(self, now: float) -> bool:
         """No progress along the route for the progress window (waiting excluded)."""

@@ -20,7 +20,7 @@ from planner.maps.distance_field import DistanceField
 from planner.maps.grid import Cell, GridMap, Point, cells_in_disc
 from planner.nav.config import GLOBAL_ALGORITHM, FusionConfig
 from planner.route.global_planner import PlanResult, plan_global
-from planner.route.parked_discs import blocking_cells
+from planner.route.parked_discs import blocking_cells, held_point
 from planner.route.route_check import blocked_point
 
 PARKED_ROUNDS = 3
@@ -52,6 +52,7 @@ class PlanKeeper:
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
         self.rounded: set[Cell] = set()  # cells of standing walkers a replan went round
         self.parked_in_way = False  # one of the parked AGVs is on the route: replan
+        self.parked_by: list = []  # ((x, y), radius, who) of those AGVs, to name them
         self.route_stale = False  # new obstacles sensed since the route was last checked
         self.map_error = ""  # why the last search could not start (a MapError), if it could not
 
@@ -68,12 +69,14 @@ class PlanKeeper:
         self.route_stale = True
         return True
 
-    def park(self, discs, route: list[Point] | None) -> None:
+    def park(self, discs, route: list[Point] | None, labels=()) -> None:
         """AGVs that stopped for good (arrived, failed) at (x, y, radius): obstacles for
         every later global plan (DWA sees them as discs anyway); ``route``: the rest of the
-        route (None: none), which one of them may block."""
+        route (None: none), which one of them may block; ``labels`` name them in a failure
+        they cause."""
         if self.costmap is None:
             return
+        self.parked_by = [((x, y), r, label) for (x, y, r), label in zip(discs, labels)]
         cells = set()
         for x, y, radius in discs:
             cells |= cells_in_disc(self.grid, (x, y), radius)
@@ -143,7 +146,8 @@ class PlanKeeper:
                 costmap=costmap,
             )
         except MapError as err:  # e.g. standing in a cell now known to be blocked
-            self.map_error = str(err)
+            points = {"goal": self.goal, "start": position}
+            self.map_error = held_point(self.grid, points, self.parked_by) or str(err)
             return PlanResult(self.algorithm, position, self.goal, False)
 
     def _round_parked(self, plan: PlanResult, position: Point, moving) -> PlanResult:

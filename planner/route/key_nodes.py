@@ -31,6 +31,7 @@ import itertools
 
 import numpy as np
 
+from planner.maps.clearance import TOLERANCE
 from planner.maps.grid import Cell, GridMap
 from planner.maps.segment_clearance import segment_clearance, segment_is_clear
 
@@ -54,9 +55,11 @@ def drop_collinear(cells: list[Cell]) -> list[Cell]:
 
 
 def extract_key_nodes(grid: GridMap, cells: list[Cell], safety_distance: float) -> list[Cell]:
-    """Start, key nodes and goal of a cell path; ``safety_distance`` in metres."""
+    """Start, key nodes and goal of a cell path; ``safety_distance`` in metres. A segment
+    must keep *more* than it from obstacle centres: one that keeps it only up to the
+    rounding of metres into cells (``clearance.TOLERANCE``) does not."""
     nodes = drop_collinear(cells)
-    safety_cells = safety_distance / grid.resolution
+    safety_cells = (safety_distance + TOLERANCE) / grid.resolution
     blocked = grid.blocked.view(np.uint8)
     i = 0
     while i + 2 < len(nodes):

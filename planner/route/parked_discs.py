@@ -15,7 +15,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from planner.maps.grid import Cell, GridMap, Point
+from planner.maps.grid import Cell, GridMap, Point, cells_in_disc
 from planner.route.route_check import route_samples
 
 AT_REST = 0.05  # m/s: a disc slower than this counts as parked
@@ -53,3 +53,20 @@ def blocking_cells(
         if np.hypot(points[:, 0] - x, points[:, 1] - y).min() < r + radius:
             cells += covered_cells(grid, (x, y), r)
     return cells
+
+
+Parked = Sequence[tuple[Point, float, str]]
+"""AGVs stopped for good as ((x, y), radius, who): who is a label naming the AGV."""
+
+
+def held_point(grid: GridMap, points: dict[str, Point], parked: Parked) -> str | None:
+    """ "goal (x, y) is held by <who>" for the first of ``points`` (what -> point) whose
+    cell lies in the cells of a stopped AGV (as a global plan blocks them); None if none."""
+    for what, point in points.items():
+        if not grid.contains_point(point):
+            continue
+        cell = grid.cell_of(point)
+        for centre, radius, who in parked:
+            if cell in cells_in_disc(grid, centre, radius):
+                return f"{what} ({point[0]:g}, {point[1]:g}) is held by {who}"
+    return None
