@@ -195,6 +195,7 @@ class FusionController:
         self.parked: set[Cell] = set()  # cells of AGVs parked for good (``park``)
         self._rounded: set[Cell] = set()  # cells of standing walkers a replan went round
         self._parked_in_way = False  # one of them is on the route: replan
+        self.may_arrive = True  # False: at the goal, but the traffic schedule has it pass on
 
     # --- planning -----------------------------------------------------------------
     def start(
@@ -307,7 +308,7 @@ class FusionController:
             return _step(stop, self.status)
         position = (pose[0], pose[1])
         self.trail.note(position)
-        if math.dist(position, self.goal) <= self.config.goal_tolerance:
+        if self.may_arrive and math.dist(position, self.goal) <= self.config.goal_tolerance:
             if not self.behaviour.smooth_arrival or is_stopped(command):
                 self.status = "arrived"
                 return _step(stop, self.status)
