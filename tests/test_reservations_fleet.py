@@ -6,9 +6,11 @@ from __future__ import annotations
 
 import os
 import signal
+from pathlib import Path
 
 import pytest
 
+from benchmarks.mapf_bench import scenario_for
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process, run_recorded
 from fleet.scenario import ScenarioError, parse_scenario, with_traffic
@@ -89,6 +91,18 @@ def test_reserved_nodes_never_overlap_and_bodies_keep_apart():
     summary = run_in_process(parse_scenario(shelves_text()), sink)
     assert summary.success and not overlaps
     assert min(a.min_clearance for a in summary.agvs) > 0.0
+
+
+DATA = Path(__file__).parent / "data" / "movingai"
+
+
+def test_one_cell_doors_of_the_mapf_room_map_ten_agents_all_arrive():
+    """room-32-32-4 (MovingAI MAPF benchmark), the first 10 agents of random-6."""
+    scenario = scenario_for(
+        DATA / "room-32-32-4.map", DATA / "room-32-32-4-random-6.scen", 10, 600.0
+    )
+    summary = run_in_process(with_traffic(scenario, "reservations"))
+    assert summary.success, summary.table()
 
 
 def test_zones_mode_is_the_default_and_bad_modes_are_refused():
