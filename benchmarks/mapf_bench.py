@@ -11,7 +11,9 @@ arrivals, collisions, whether the run reached its time limit, the flowtime ratio
 limit), the makespan ratio (last arrival ÷ longest solo run), and the traffic layer's
 CPU per AGV per tick (the world's schedule, mode "reservations"). ``--zenoh K`` also
 runs the first K instances over Zenoh and says whether every AGV's status and arrival
-time equal the in-process run's.
+time equal the in-process run's. ``--kill-9 N`` runs only the first warehouse instance
+with N agents over Zenoh and kills (-9, by PID) the first AGV seen driving in a
+single-lane aisle: the others must arrive, or fail naming it.
 
 The data (``/work/shared/data/mapf`` by default, the MovingAI MAPF benchmark: see its
 README) is read from ``--data``; a missing file is one line of error and exit status 2.
@@ -24,6 +26,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
+import os
+import signal
 import sys
 import time
 from dataclasses import replace
@@ -126,6 +131,58 @@ def run_zenoh(scenario: Scenario, traffic: str) -> list:
     return [(a.status, a.arrival_time) for a in summary.agvs]
 
 
+def in_aisle(scenario: Scenario, point) -> bool:
+    """Whether a point lies in a single-lane aisle: its cell is free with blocked cells
+    left and right, or above and below."""
+    grid = scenario.grid
+    col, row = grid.cell_of(point)
+
+    def blocked(c, r):
+        return not grid.contains_cell((c, r)) or bool(grid.blocked[r, c])
+
+    return (blocked(col - 1, row) and blocked(col + 1, row)) or (
+        blocked(col, row - 1) and blocked(col, row + 1)
+    )
+
+
+def kill_9(scenario: Scenario, traffic: str) -> int:
+    """Over Zenoh: kill -9 (by its PID) the first AGV seen driving inside a single-lane
+    aisle; the others must arrive, or fail naming it."""
+    from fleet.runtime.launcher import FleetOptions, run_fleet
+    from tests.processes import agv_pid
+
+    path = ROOT / "runs" / f"{scenario.name}-kill.toml"
+    path.parent.mkdir(exist_ok=True)
+    path.write_text(scenario.source.replace("[map]", f'[traffic]\nmode = "{traffic}"\n[map]', 1))
+    killed = {}
+
+    def progress(world):
+        for name, state in world.states.items():
+            point = (state.x, state.y)
+            driving = world.tick > 20 and world.records[name].status == "driving"
+            moving = math.hypot(state.vx, state.vy) > 0.2
+            if not killed and driving and moving and in_aisle(scenario, point):
+                os.kill(agv_pid(name), signal.SIGKILL)
+                killed[name] = (round(state.x, 2), round(state.y, 2), world.time)
+
+    options = FleetOptions(str(path), grace=0.0)
+    summary = run_fleet(parse_scenario(path.read_text(), path), options, progress).to_json()
+    (victim,) = killed or {"-": None}
+    agvs = summary["agvs"]
+    ok = [a for a in agvs if a["name"] != victim]
+    arrived = sum(a["status"] == "arrived" for a in ok)
+    named = [a for a in ok if a["status"] != "arrived" and victim in a["failure"]]
+    neither = len(ok) - arrived - len(named)
+    print(f"kill -9 of {victim} at {killed.get(victim)} (x, y, t): of the {len(ok)} others "
+          f"{arrived} arrived, {len(named)} failed naming it, {neither} neither; "
+          f"collisions {summary['collisions']}")  # fmt: skip
+    for a in named:
+        print(f"  {a['name']}: {a['failure']}")
+    good = killed and arrived + len(named) == len(ok) and not summary["collisions"]
+    print(f"kill -9 target: {'PASS' if good else 'MISS'}")
+    return 0
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--data", type=Path, default=DATA, help=f"MovingAI files (default {DATA})")
@@ -136,6 +193,10 @@ def main(argv=None) -> int:
     p.add_argument("--time-limit", type=float, default=900.0)
     p.add_argument("--zenoh", type=int, default=0, metavar="K")
     p.add_argument("--json", action="store_true")
+    p.add_argument(
+        "--kill-9", type=int, metavar="N", help="only: N agents of the first warehouse .scen "
+        "over Zenoh, kill -9 of the first AGV driving in an aisle",
+    )  # fmt: skip
     args = p.parse_args(argv)
     try:
         return _bench(args)
@@ -145,6 +206,14 @@ def main(argv=None) -> int:
 
 
 def _bench(args) -> int:
+    if args.kill_9:
+        map_name = SUITES["warehouse"][0]
+        k = args.scens.split(",")[0]
+        scen = args.data / f"{map_name}-random-{k}.scen"
+        if not scen.is_file():
+            raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")
+        scenario = scenario_for(args.data / f"{map_name}.map", scen, args.kill_9, args.time_limit)
+        return kill_9(scenario, args.traffic)
     suites = list(SUITES) if args.suite == "all" else [args.suite]
     cache = json.loads(SOLO_CACHE.read_text()) if SOLO_CACHE.exists() else {}
     rows, zenoh_left = [], args.zenoh

@@ -15,8 +15,12 @@ close one is skipped, like a swap (a swap is the rotation of two).
 The priority of an agent grows by one each step it is not at its goal and drops to
 its tie-break (below one) when it is there, as in PIBT: an agent kept from its goal
 for long ends up first. Everything is deterministic: ties between candidates are
-broken by a fixed hash of agent and node, ties between agents by a hash of agent and
-step (``next_priorities``), then their index.
+broken by going on straight, for an agent not pushed by another (a vehicle stops to
+turn: with the hash alone the many shortest ways across an open floor became
+staircases, a turn at every node; for pushed agents too, two agents swapping through
+a corridor with a side pocket pushed each other back and forth for ever), then by a
+fixed hash of agent and node; ties between agents by a hash of agent and step
+(``next_priorities``), then their index.
 """
 
 from __future__ import annotations
@@ -35,14 +39,16 @@ def step(
     distances: list[np.ndarray],
     priorities: list[float],
     fixed: frozenset[int] | set[int] = frozenset(),
+    directions: list[int] | None = None,
 ) -> list[int]:
     """The next node of every agent. ``current[i]`` is agent i's node, ``distances[i]``
     its table of steps to its goal, ``priorities[i]`` its priority; ``fixed`` nodes are
-    taken by bodies that never move (no agent is planned onto them)."""
-    planner = _Step(neighbours, current, distances, fixed)
+    taken by bodies that never move (no agent is planned onto them); ``directions[i]``
+    the direction (index into a node's neighbours) of agent i's last move, -1 none."""
+    planner = _Step(neighbours, current, distances, fixed, directions)
     for i in sorted(range(len(current)), key=lambda a: (-priorities[a], a)):
         if planner.to[i] is None:
-            planner.plan(i)
+            planner.plan(i, first=True)
     return [int(v) for v in planner.to]
 
 
@@ -69,25 +75,33 @@ def _tie_break(agent: int, step: int) -> float:
 
 
 class _Step:
-    def __init__(self, neighbours, current, distances, fixed):
+    def __init__(self, neighbours, current, distances, fixed, directions):
         self.neighbours = neighbours
+        self.directions = directions or [-1] * len(current)
         self.frm = current
         self.distances = distances
         self.to: list[int | None] = [None] * len(current)
         self.now = {v: i for i, v in enumerate(current)}
         self.taken: dict[int, int] = dict.fromkeys(fixed, -1)
 
-    def candidates(self, i: int) -> list[int]:
+    def candidates(self, i: int, first: bool) -> list[int]:
         here = self.frm[i]
         nodes = [here, *(int(v) for v in self.neighbours[here] if v >= 0)]
         dist = self.distances[i]
+        d = self.directions[i] if first else -1  # pushed: no preference
+        ahead = int(self.neighbours[here][d]) if d >= 0 else -1
         return sorted(
             nodes,
-            key=lambda v: (int(dist[v]), v in self.now and v != here, (v * _HASH + i) % 2**32),
+            key=lambda v: (
+                int(dist[v]),
+                v in self.now and v != here,
+                v != ahead,
+                (v * _HASH + i) % 2**32,
+            ),
         )
 
-    def plan(self, i: int) -> bool:
-        for v in self.candidates(i):
+    def plan(self, i: int, first: bool = False) -> bool:
+        for v in self.candidates(i, first):
             if v in self.taken or self._closes_cycle(i, v):
                 continue
             self.to[i], self.taken[v] = v, i

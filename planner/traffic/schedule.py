@@ -106,6 +106,7 @@ class Schedule:
             roadmap.distances(g)[s] / max(1, len(roadmap)) if roadmap.distances(g)[s] <
             UNREACHABLE else 0.0 for s, g in zip(starts, self.goals, strict=True)
         ]  # fmt: skip
+        self.directions = [-1] * len(agents)  # of each agent's last planned move
         self.frozen: set[int] = set()  # agents planned onto their goals: fixed from then on
         self.failed: dict[int, set[int]] = {}  # agents stopped for good off plan: their nodes
         self.done: set[int] = set()  # agents that arrived or failed
@@ -211,12 +212,15 @@ class Schedule:
         current = [self.config[a] for a in moving]
         tables = [self.roadmap.distances(self.goals[a], fixed) for a in moving]
         priorities = [self.priorities[a] for a in moving]
-        nodes = pibt.step(self.roadmap.neighbours, current, tables, priorities, fixed)
+        directions = [self.directions[a] for a in moving]
+        nodes = pibt.step(self.roadmap.neighbours, current, tables, priorities, fixed, directions)
         goals = [self.goals[a] for a in moving]
         self.step += 1
         for a, node, p in zip(
             moving, nodes, pibt.next_priorities(priorities, nodes, goals, moving, self.step)
         ):
+            if node != self.config[a]:
+                self.directions[a] = list(self.roadmap.neighbours[self.config[a]]).index(node)
             self.config[a], self.priorities[a] = node, p
             self.plan.append(a, node, self.step)
         self._freeze_at_goals()
