@@ -205,3 +205,19 @@ def test_a_failed_agent_is_gone_round_or_named():
 def test_two_agents_on_one_node_is_an_error():
     with pytest.raises(ScheduleError, match="same roadmap node"):
         Schedule(roadmap_of(RING), [("A", at((1, 1)), at((3, 3))), ("B", at((1, 1)), at((2, 1)))])
+
+
+def test_a_new_goal_joins_at_any_tick():
+    """Lifelong: A0 is on its way to the ring's far corner when it is given another goal;
+    the next planned steps go there, and A1 keeps out of its way."""
+    roadmap = roadmap_of(RING)
+    schedule = Schedule(roadmap, [("A0", at((1, 1)), at((3, 3))), ("A1", at((3, 1)), at((1, 3)))])
+    where = {"A0": at((1, 1)), "A1": at((3, 1))}
+    schedule.update(where)
+    schedule.set_goal("A0", at((2, 1)))
+    for _ in range(40):
+        for r in schedule.update(where):
+            if len(r.path) > 1:
+                where[r.name] = tuple(r.path[1])
+            assert len(set(where.values())) == 2
+    assert where["A0"] == at((2, 1)) and where["A1"] == at((1, 3))

@@ -102,10 +102,9 @@ class Schedule:
         self.plan = Precedence(starts)
         self.config = list(starts)  # every agent's node at plan step ``self.step``
         self.step = 0
-        self.priorities = [
-            roadmap.distances(g)[s] / max(1, len(roadmap)) if roadmap.distances(g)[s] <
-            UNREACHABLE else 0.0 for s, g in zip(starts, self.goals, strict=True)
-        ]  # fmt: skip
+        # PIBT's first priorities: the trip length as a fraction (longer trips first)
+        trips = [int(roadmap.distances(g)[s]) for s, g in zip(starts, self.goals, strict=True)]
+        self.priorities = [t / max(1, len(roadmap)) if t < UNREACHABLE else 0.0 for t in trips]
         self.directions = [-1] * len(agents)  # of each agent's last planned move
         self.frozen: set[int] = set()  # agents planned onto their goals: fixed from then on
         self.failed: dict[int, set[int]] = {}  # agents stopped for good off plan: their nodes
@@ -122,11 +121,13 @@ class Schedule:
 
     # --- lifelong -----------------------------------------------------------------------
     def set_goal(self, name: str, goal: Point) -> None:
-        """A new goal for a running AGV: the next planned steps go there."""
+        """A new goal for a running AGV: the plan is made again from the nodes everybody
+        holds, towards it."""
         agent = self.names.index(name)
         self.goals[agent] = self._node(name, goal, "goal")
         self.goal_points[agent] = tuple(goal)
         self.frozen.discard(agent)
+        self._plan_again()
 
     def fail(self, name: str, position: Point) -> None:
         """An AGV stopped for good off its plan (failed, died, cut off): a body on the nodes
@@ -144,10 +145,15 @@ class Schedule:
             if math.dist(self.roadmap.centres[n], position) < reach
         } - (held - {self.plan.nodes[agent][-1]})  # fmt: skip
         self.failed[agent] = covered | {self.plan.nodes[agent][-1]}
-        for other in range(len(self.names)):
-            if other != agent:
-                self.plan.truncate(other)
-                self.config[other] = self.plan.nodes[other][-1]
+        self._plan_again()
+
+    def _plan_again(self) -> None:
+        """Drop every plan beyond its released nodes: the next steps start from there
+        (a step of PIBT needs every agent on a node of its own: the held ones are)."""
+        for agent in range(len(self.names)):
+            if agent not in self.failed:
+                self.plan.truncate(agent)
+                self.config[agent] = self.plan.nodes[agent][-1]
         self.frozen = {a for a in self.frozen if self.config[a] == self.goals[a]}
 
     def arrived(self, name: str) -> None:
