@@ -117,6 +117,17 @@ class Schedule:
         node = self.roadmap.node_at(point)
         if node is None:
             raise ScheduleError(f"AGV {name!r}: its {what} {tuple(point)} is on no roadmap node")
+        off = math.dist(point, self.roadmap.centres[node])
+        if off > self.roadmap.reach:
+            # a body standing off its node reaches into the next one's room (single-lane,
+            # 0.5 m cells: an AGV parked at its goal 0.56 m off its node was hit)
+            x, y = self.roadmap.centre(node)
+            raise ScheduleError(
+                f"AGV {name!r}: its {what} {tuple(point)} is {off:.2f} m from the nearest "
+                f"roadmap node ({x:g}, {y:g}), more than {self.roadmap.reach:.2f} m: put it "
+                "on a node (the lattice of cells the body fits, every "
+                f"{self.roadmap.spacing} cells)"
+            )
         return node
 
     # --- lifelong -----------------------------------------------------------------------
