@@ -5,7 +5,8 @@
 (from the repository root) runs, in process, each instance: the map at 1 m cells, AGVs of
 radius 0.3 m at 1 m/s, 0.5 m/s², 60 °/s, starts and goals the first N rows of the
 ``.scen`` file, in the chosen traffic mode; and each AGV alone on the same map (its solo
-run, no traffic: its own route and DWA; cached in ``runs/mapf_solo.json``). Per instance:
+run, in the same traffic mode by default, ``--solo zones`` its own route and DWA; cached in
+``runs/mapf_solo.json``). Per instance:
 arrivals, collisions, whether the run reached its time limit, the flowtime ratio
 (Σ arrival times ÷ Σ solo arrival times; an AGV that did not arrive counts the time
 limit), the makespan ratio (last arrival ÷ longest solo run), and the traffic layer's
@@ -78,13 +79,14 @@ def scenario_for(map_path: Path, scen_path: Path, n: int, time_limit: float) -> 
     return parse_scenario("\n".join(lines) + "\n", scen_path)
 
 
-def solo_times(scenario: Scenario, key: str, cache: dict) -> list[float]:
-    """Each AGV alone on the map, no traffic rule (its route and DWA): arrival times."""
+def solo_times(scenario: Scenario, key: str, cache: dict, mode: str) -> list[float]:
+    """Each AGV alone on the map in traffic mode ``mode`` (zones alone: no rule, its route
+    and DWA; reservations alone: straight from node to node): arrival times."""
     out = []
     for spec in scenario.agvs:
-        k = f"{key}/{spec.start}/{spec.goal}"
+        k = f"{key}/{spec.start}/{spec.goal}" + ("" if mode == ZONES else f"/{mode}")
         if k not in cache:
-            alone = replace(with_traffic(scenario, ZONES), agvs=(spec,), name=f"{key}-solo")
+            alone = replace(with_traffic(scenario, mode), agvs=(spec,), name=f"{key}-solo")
             agv = run_in_process(alone).agvs[0]
             cache[k] = agv.arrival_time if agv.status == "arrived" else None
         out.append(cache[k])
@@ -191,6 +193,11 @@ def main(argv=None) -> int:
     p.add_argument("--scens", default="6,7,8,9,10", help="which random-K .scen files")
     p.add_argument("--traffic", default="reservations", choices=("reservations", "zones"))
     p.add_argument("--time-limit", type=float, default=900.0)
+    p.add_argument(
+        "--solo", choices=("same", "zones"), default="same",
+        help="the solo runs in the same traffic mode (default: the ratios measure what the "
+        "others cost) or in zones (each AGV's own route and DWA)",
+    )  # fmt: skip
     p.add_argument("--zenoh", type=int, default=0, metavar="K")
     p.add_argument("--json", action="store_true")
     p.add_argument(
@@ -229,7 +236,8 @@ def _bench(args) -> int:
                 raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")
             for n in agents:
                 scenario = scenario_for(map_path, scen, n, args.time_limit)
-                solo = solo_times(scenario, scen.stem, cache)
+                solo_mode = args.traffic if args.solo == "same" else ZONES
+                solo = solo_times(scenario, scen.stem, cache, solo_mode)
                 SOLO_CACHE.parent.mkdir(exist_ok=True)
                 SOLO_CACHE.write_text(json.dumps(cache))
                 result = run_instance(scenario, args.traffic)

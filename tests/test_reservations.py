@@ -221,3 +221,9 @@ def test_a_new_goal_joins_at_any_tick():
                 where[r.name] = tuple(r.path[1])
             assert len(set(where.values())) == 2
     assert where["A0"] == at((2, 1)) and where["A1"] == at((1, 3))
+
+
+def test_a_start_off_its_node_is_an_error():
+    """A body standing between nodes reaches into a neighbour's room: refused."""
+    with pytest.raises(ScheduleError, match="from the nearest roadmap node"):
+        Schedule(roadmap_of(RING), [("A", (1.9, 1.5), at((3, 3)))])
