@@ -167,7 +167,7 @@ def kill_9(scenario: Scenario, traffic: str) -> int:
                 os.kill(agv_pid(name), signal.SIGKILL)
                 killed[name] = (round(state.x, 2), round(state.y, 2), world.time)
 
-    options = FleetOptions(str(path), grace=0.0)
+    options = FleetOptions(str(path), tick_timeout=10.0)  # a busy machine is not a death
     summary = run_fleet(parse_scenario(path.read_text(), path), options, progress).to_json()
     (victim,) = killed or {"-": None}
     agvs = summary["agvs"]
@@ -178,8 +178,10 @@ def kill_9(scenario: Scenario, traffic: str) -> int:
     print(f"kill -9 of {victim} at {killed.get(victim)} (x, y, t): of the {len(ok)} others "
           f"{arrived} arrived, {len(named)} failed naming it, {neither} neither; "
           f"collisions {summary['collisions']}")  # fmt: skip
-    for a in named:
-        print(f"  {a['name']}: {a['failure']}")
+    print(f"end: {summary['end_reason']}")
+    for a in agvs:
+        if a["status"] != "arrived":
+            print(f"  {a['name']}: {a['status']} {a['failure']}")
     good = killed and arrived + len(named) == len(ok) and not summary["collisions"]
     print(f"kill -9 target: {'PASS' if good else 'MISS'}")
     return 0
