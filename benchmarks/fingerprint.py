@@ -80,7 +80,8 @@ def fingerprint(job: tuple[str, str, tuple]) -> tuple[str, dict]:
             msg = dataclasses.replace(msg, agvs=agvs)
         if key in ("world/tick", "world/event") or key.endswith("/command"):
             digest.update(key.encode())
-            digest.update(repr(msg).encode())
+            # a tick of the zone rule carries no reservations: hashed as before the field
+            digest.update(repr(msg).replace(", reservations=[])", ")").encode())
 
     t0 = time.perf_counter()
     summary = run_in_process(scenario_of(kind, args), outbox)

@@ -18,6 +18,7 @@ import msgspec
 
 from planner.core.errors import BadInputError
 from planner.core.status import DRIVING, RECOVERY_KINDS, STATUSES
+from planner.traffic.schedule import Reservation
 from planner.traffic.zones import PHASES, Intent
 
 # No list in a message is longer (a tick's AGVs, a plan's path on the largest map):
@@ -120,6 +121,8 @@ class Tick:
     temporary: list[list[int]] = field(default_factory=list)
     final: bool = False
     intents: list[Intent] = field(default_factory=list)  # passage claims, of tick k-1
+    # traffic mode "reservations": the nodes each running AGV may enter, and whom it waits for
+    reservations: list[Reservation] = field(default_factory=list)
 
 
 @dataclass

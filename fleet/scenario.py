@@ -42,8 +42,13 @@ from planner.nav.fusion import VARIANTS, FusionConfig
 
 TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
-    "map", "planner", "agv_defaults", "agvs", "obstacles",
+    "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic",
 )  # fmt: skip
+ZONES, RESERVATIONS = "zones", "reservations"
+TRAFFIC_MODES = (ZONES, RESERVATIONS)
+"""How AGVs share space: the zone rule (``planner.traffic.zones``: one direction holds a
+passage) or node reservations in time (``planner.traffic.schedule``: PIBT steps)."""
+TRAFFIC_KEYS = ("mode",)
 # the control period (s) and the longest run (s): at most 3.6 million ticks, and no
 # run whose clock never reaches its end (a dt of 1e-9 was accepted)
 DT_RANGE = (0.01, 1.0)
@@ -112,6 +117,7 @@ class Scenario:
     moving: tuple[MovingObstacle, ...]
     source: str
     path: str
+    traffic: str = ZONES  # TRAFFIC_MODES
 
     def __post_init__(self) -> None:
         # dt is the run's one control period: the world steps by it, each AGV's DWA plans
@@ -177,6 +183,8 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     _parse_config(planner_defaults, "planner", vehicle_defaults, "agv_defaults", dt, profile)
     agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile)
     temporary, moving = _parse_obstacles(get_list(doc, "obstacles", "", default=[]), grid)
+    traffic = get_table(doc, "traffic", "")
+    check_keys(traffic, TRAFFIC_KEYS, "traffic")
     return Scenario(
         name=name,
         description=get_str(doc, "description", "", default=""),
@@ -191,6 +199,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         moving=moving,
         source=text,
         path=str(path) if path else "",
+        traffic=get_str(traffic, "mode", "traffic", default=ZONES, choices=TRAFFIC_MODES),
     )
 
 
@@ -377,6 +386,15 @@ def with_profile(scenario: Scenario, profile: str) -> Scenario:
         raise ScenarioError(f"unknown profile {profile!r}: choose one of {', '.join(PROFILES)}")
     agvs = tuple(replace(a, config=replace(a.config, profile=profile)) for a in scenario.agvs)
     return replace(scenario, agvs=agvs)
+
+
+def with_traffic(scenario: Scenario, mode: str) -> Scenario:
+    """The same scenario with traffic mode ``mode`` (``TRAFFIC_MODES``)."""
+    if mode not in TRAFFIC_MODES:
+        raise ScenarioError(
+            f"unknown traffic mode {mode!r}: choose one of {', '.join(TRAFFIC_MODES)}"
+        )
+    return replace(scenario, traffic=mode)
 
 
 def with_algorithm(scenario: Scenario, algorithm: str) -> Scenario:

@@ -25,6 +25,9 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
 - traffic: waiting time, the ticks an AGV reports ``waiting`` (held outside a
   passage by the traffic rule) times dt; waits, the ``wait`` events naming it
   first; the run's traffic events, every ``wait``, ``go`` and ``yield`` event.
+  Traffic mode "reservations": ``reservations``, the ``reserved`` events (nodes released
+  to an AGV by the schedule); ``reservation_waits``, the ``waits-for`` events (an AGV
+  waits for another to leave the node it needs next), also counted in each AGV's waits.
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ from planner.core.motion import world_velocity
 from planner.core.status import ARRIVED, COLLISION, FINISHED, RECOVERY, REPLAN, WAITING
 from planner.maps.distance_field import DistanceField
 from planner.nav.fusion import GLOBAL_ALGORITHM
+from planner.traffic.schedule import RESERVED, WAITS_FOR
 from planner.traffic.zones import DECISIONS, WAIT
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
@@ -103,6 +107,8 @@ class RunAnalysis:
     agvs: tuple[AgvAnalysis, ...]
     waiting_time: float = 0.0  # s, summed over AGVs
     traffic_events: int = 0  # wait, go and yield events
+    reservations: int = 0  # "reserved" events (traffic mode "reservations")
+    reservation_waits: int = 0  # "waits-for" events
     self_crossings: int = 0  # summed over AGVs
     recoveries: int = 0  # summed over AGVs
 
@@ -142,7 +148,12 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
     collisions = [e for e in series.events if e.get("kind") == COLLISION]
     hits = Counter(n for e in collisions for n in e.get("agvs", []))
     traffic = [e for e in series.events if e.get("kind") in DECISIONS]
-    waits = Counter(e["agvs"][0] for e in traffic if e.get("kind") == WAIT and e.get("agvs"))
+    waits_for = [e for e in series.events if e.get("kind") == WAITS_FOR]
+    waits = Counter(
+        e["agvs"][0]
+        for e in [*traffic, *waits_for]
+        if e.get("kind") in (WAIT, WAITS_FOR) and e.get("agvs")
+    )
     recoveries = Counter(
         e["agvs"][0] for e in series.events if e.get("kind") == RECOVERY and e.get("agvs")
     )
@@ -183,6 +194,8 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         agvs=tuple(agvs),
         waiting_time=sum(a.waiting_time for a in agvs),
         traffic_events=len(traffic),
+        reservations=sum(e.get("kind") == RESERVED for e in series.events),
+        reservation_waits=len(waits_for),
         self_crossings=sum(a.self_crossings for a in agvs),
         recoveries=sum(a.recoveries for a in agvs),
     )
@@ -352,6 +365,8 @@ COMPARED = (
     ("self_crossings", "loops (path self-crossings)", ""),
     ("waiting_time", "waiting time", "s"),
     ("traffic_events", "traffic events", ""),
+    ("reservations", "node reservations", ""),
+    ("reservation_waits", "waits for a reserved node", ""),
     ("recoveries", "recoveries", ""),
     ("plan_time_mean_ms", "plan time mean", "ms"),
     ("plan_time_p95_ms", "plan time p95", "ms"),

@@ -28,6 +28,9 @@ Entity paths (everything on the map under ``world``, in world coordinates):
                                   with whom it waits for (cleared when it goes)
     world/agv/<name>/waiting/place  LineStrips2D: from that AGV to the waiting place the rule
                                   sent it to (cleared when it goes)
+    world/roadmap                 LineStrips2D, static: the roadmap's edges (traffic mode
+                                  "reservations"), for the first AGV's radius
+    world/agv/<name>/reserved     LineStrips2D: the nodes the schedule reserved for the AGV
     events/<kind>                 TextLog: one entity per kind of event (the world's events:
                                   arrived, failed, collision, end, wait, go, yield, ...; and
                                   from the plans: replan, no path)
@@ -51,6 +54,7 @@ from planner.core.status import COLLISION, FAILED, FINISHED, INITIAL, RECOVERY, 
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.traffic.passages import NONE, Passages
+from planner.traffic.roadmap import Roadmap
 from planner.traffic.zones import HELD
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
@@ -63,6 +67,7 @@ MAP = "world/map"
 TEMPORARY = "world/temporary"
 MOVING = "world/moving"
 PASSAGES = "world/passages"
+ROADMAP = "world/roadmap"
 PASSAGE_RGBA = (255, 160, 0, 90)  # translucent orange over the map
 EVENTS = "events"
 VELOCITY = "velocity"
@@ -146,6 +151,8 @@ class RowMaker:
         self._temporary: list[list[int]] = []
         self._map_msg: dict | None = None
         self._waiting_shown: set[str] = set()
+        self._roadmap_of: dict | None = None  # the map, until the roadmap is drawn
+        self._reserved_shown: set[str] = set()
         self._pending = world_rows()
 
     def feed(self, topic: str, data: dict) -> list[Row]:
@@ -178,7 +185,7 @@ class RowMaker:
     def _map(self, data: dict, rows: list[Row]) -> None:
         """The grid as one image, a pixel per cell (filled obstacles, and one image
         whatever the map's size), placed on the world by its transform."""
-        self._map_msg = data
+        self._map_msg = self._roadmap_of = data
         res = self._resolution = data["resolution"]
         x0, y0 = self._origin = map_origin(data)
         h = map_size(data)[1]
@@ -221,6 +228,9 @@ class RowMaker:
             ),
             "dwa": rr.LineStrips2D.from_fields(colors=WHITE, radii=thin, draw_order=22.0),
             "waiting": rr.Points2D.from_fields(colors=ORANGE, show_labels=True, draw_order=29.0),
+            "reserved": rr.LineStrips2D.from_fields(
+                colors=faded, radii=rr.Radius.ui_points(4.0), draw_order=14.0
+            ),
         }
         for part, style in styles.items():
             rows.append(Row(agv_path(name, part), None, None, [style]))
@@ -235,6 +245,7 @@ class RowMaker:
             rows.append(_passages(self._map_msg, data["agvs"][0]["radius"]))
             self._map_msg = None
         self._waiting(t, data, rows)
+        self._reserved(t, data, rows)
         for s in data["agvs"]:
             name = s["name"]
             self._meet(name, rows)
@@ -289,6 +300,21 @@ class RowMaker:
                 self._waiting_shown.discard(name)
                 rows.append(Row(agv_path(name, "waiting"), kinds.points, t, ([], [], [])))
                 rows.append(Row(agv_path(name, "waiting/place"), kinds.strips, t, []))
+
+    def _reserved(self, t: float, data: dict, rows: list[Row]) -> None:
+        """Traffic mode "reservations": the roadmap once, and each AGV's reserved nodes."""
+        reservations = data.get("reservations", [])  # none before the mode existed
+        if reservations and self._roadmap_of is not None and data["agvs"]:
+            rows.append(_roadmap(self._roadmap_of, data["agvs"][0]["radius"]))
+            self._roadmap_of = None
+        now = set()
+        for r in reservations:
+            now.add(r["name"])
+            path = [r["path"]] if len(r["path"]) > 1 else []
+            rows.append(Row(agv_path(r["name"], "reserved"), kinds.strips, t, path))
+        for name in self._reserved_shown - now:
+            rows.append(Row(agv_path(name, "reserved"), kinds.strips, t, []))
+        self._reserved_shown = now
 
     def _state(self, name: str, data: dict, rows: list[Row]) -> None:
         t = self._time(data["tick"])
@@ -350,6 +376,22 @@ def _passages(map_msg: dict, radius: float) -> Row:
     res = grid.resolution
     place = rr.Transform3D(translation=[x0, y1, 0.0], scale=[res, -res, 1.0])
     return Row(PASSAGES, None, None, [place, rr.Image(rgba, color_model="RGBA", draw_order=0.5)])
+
+
+def _roadmap(map_msg: dict, radius: float) -> Row:
+    """The roadmap's edges (``planner.traffic.roadmap``), thin and grey under everything."""
+    roadmap = Roadmap.build(Costmap.build(map_grid(map_msg), Clearance(radius)))
+    edges = [
+        [roadmap.centres[a].tolist(), roadmap.centres[b].tolist()]
+        for a in range(len(roadmap))
+        for b in roadmap.neighbours[a][:2]  # east and north: each edge once
+        if b >= 0
+    ]
+    style = rr.LineStrips2D(
+        np.asarray(edges, dtype=np.float32).reshape(-1, 2, 2),
+        colors=GREY, radii=rr.Radius.ui_points(0.5), draw_order=1.0,
+    )  # fmt: skip
+    return Row(ROADMAP, None, None, [style])
 
 
 def _start(name: str, x: float, y: float, r: float) -> Row:

@@ -38,7 +38,7 @@ from fleet.runtime.progress import Progress
 from fleet.runtime.recorder_process import serve_recorder
 from fleet.runtime.world_server import START_TIMEOUT_S, TICK_TIMEOUT_S, WorldServer
 from fleet.runtime.world_watch import DEFAULT_GRACE_S, WorldGone
-from fleet.scenario import load_scenario, with_algorithm, with_profile
+from fleet.scenario import TRAFFIC_MODES, load_scenario, with_algorithm, with_profile, with_traffic
 from planner.core.profiles import PROFILES
 from planner.nav.fusion import VARIANTS
 from recordings.writer import RecordingWriter, default_recording_path
@@ -53,6 +53,7 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--zenoh-config", metavar="FILE", help="a Zenoh config file to start from")
     p.add_argument("--algorithm", choices=VARIANTS, help="override the scenario's planner")
     p.add_argument("--profile", choices=PROFILES, help="override the scenario's planner profile")
+    p.add_argument("--traffic", choices=TRAFFIC_MODES, help="override the scenario's traffic mode")
     p.add_argument(
         "--credentials",
         metavar="FILE",
@@ -148,6 +149,8 @@ def _scenario(args):
         scenario = with_algorithm(scenario, args.algorithm)
     if args.profile:
         scenario = with_profile(scenario, args.profile)
+    if args.traffic:
+        scenario = with_traffic(scenario, args.traffic)
     return scenario, args.prefix or f"agv-fleet/{scenario.name}"
 
 

@@ -25,7 +25,7 @@ from fleet.runtime.summary import summarize
 from fleet.runtime.world import World
 from fleet.runtime.world_server import TICK_TIMEOUT_S
 from fleet.runtime.world_watch import DEFAULT_GRACE_S
-from fleet.scenario import load_scenario, with_algorithm, with_profile
+from fleet.scenario import TRAFFIC_MODES, load_scenario, with_algorithm, with_profile, with_traffic
 from planner.core.profiles import PROFILES
 from planner.nav.fusion import VARIANTS
 from recordings.rerun_server import RerunError
@@ -67,6 +67,14 @@ def add_parsers(sub) -> None:
         help=(
             "plan every AGV with this planner profile instead of the scenario's: default "
             "(costmap, footprint-safe key nodes) or paper (the paper exactly)"
+        ),
+    )
+    p.add_argument(
+        "--traffic",
+        choices=TRAFFIC_MODES,
+        help=(
+            "how AGVs share space, instead of the scenario's [traffic] mode: zones (one "
+            "direction holds a passage) or reservations (PIBT node reservations in time)"
         ),
     )
     p.add_argument(
@@ -132,6 +140,8 @@ def run(args: argparse.Namespace) -> int:
         scenario = with_algorithm(scenario, args.algorithm)
     if args.profile:
         scenario = with_profile(scenario, args.profile)
+    if args.traffic:
+        scenario = with_traffic(scenario, args.traffic)
     if args.in_process and args.realtime:
         raise UsageError("--realtime needs the bus (drop --in-process)")
     record_path = None
@@ -222,6 +232,7 @@ def _run(args, scenario, record_path, progress, view):
         scenario_arg=str(args.scenario),
         algorithm=args.algorithm,
         profile=args.profile,
+        traffic=args.traffic,
         realtime=args.realtime,
         transport=args.transport,
         zenoh_config=args.zenoh_config,

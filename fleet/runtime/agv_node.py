@@ -18,15 +18,18 @@ import numpy as np
 
 from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
-from fleet.scenario import Scenario
+from fleet.scenario import RESERVATIONS, Scenario
 from planner.core.motion import moving_discs
-from planner.core.status import FAILED, FINISHED, INITIAL, REPLAN, TRAFFIC
+from planner.core.status import DRIVING, FAILED, FINISHED, INITIAL, REPLAN, TRAFFIC, WAITING
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.nav.fusion import FusionController
+from planner.nav.reserved_drive import drive_reserved
 from planner.nav.warm_up import warm_up
 from planner.route.global_planner import PlanResult
+from planner.traffic.follow import follow_point
 from planner.traffic.guard import TrafficGuard
+from planner.traffic.schedule import Reservation
 
 
 @dataclass
@@ -86,6 +89,8 @@ class AgvNode:
         self._sense(tick, pose)
         self._park(tick)
         decision = None
+        reserved = self._reservation(tick)
+        hold = None if reserved is None else self._follow(reserved)
         if self.guard is not None and self.controller.targets:
             route = self.controller.route_ahead()
             stalled = self.controller.stalled(tick.time)
@@ -96,15 +101,25 @@ class AgvNode:
                 plan_msg = self._plan_msg(tick, self.controller.replan((me.x, me.y)), TRAFFIC)
                 self.guard.replanned()
         walkers = _walkers(tick)
-        step = self.controller.step(
-            pose, (me.vx, me.vy, me.omega), tick.time, self._discs(tick, walkers), walkers,
-            hold=decision.hold if decision else None,
-        )  # fmt: skip
+        discs = self._discs(tick, walkers)
+        velocity = (me.vx, me.vy, me.omega)
+        if reserved is not None:
+            final = self.controller.may_arrive
+            step = drive_reserved(
+                self.controller, pose, velocity, tick.time, hold, final, discs, walkers
+            )
+        else:
+            step = self.controller.step(
+                pose, velocity, tick.time, discs, walkers, hold=decision.hold if decision else None
+            )
         if step.plan is not None:
             plan_msg = self._plan_msg(tick, step.plan, REPLAN)
             if self.guard is not None:
                 self.guard.replanned()
-        command = self._command(tick, step.command, step.status, step.target)
+        status = step.status
+        if reserved is not None and status == WAITING and len(reserved.path) > 1:
+            status = DRIVING  # on its way along reserved nodes: driving, not waiting
+        command = self._command(tick, step.command, status, step.target)
         command.plan_time_ms = step.plan_time_s * 1e3
         command.start_heading = start_heading
         command.failure = self.controller.failure if step.status == FAILED else ""
@@ -116,6 +131,23 @@ class AgvNode:
                 self.name, tick.tick, step.trajectory[:, :2].round(4).tolist()
             )
         return NodeOutput(command, plan_msg, trajectory)
+
+    def _reservation(self, tick: Tick) -> Reservation | None:
+        """This AGV's reservation in ``tick`` (traffic mode "reservations"), else None."""
+        if self.scenario.traffic != RESERVATIONS:
+            return None
+        return next((r for r in tick.reservations if r.name == self.name), None)
+
+    def _follow(self, reserved: Reservation):
+        """Where to drive on the reserved nodes (``planner.traffic.follow``); it may arrive
+        only on the schedule's last node, its goal. Cut off from its goal by AGVs stopped
+        for good, it fails naming them."""
+        if reserved.blocked_by and not self.controller.mode.finished:
+            who = ", ".join(reserved.blocked_by)
+            self.controller.fail(f"cut off from its goal by {who} (stopped for good)")
+        hold = follow_point(reserved.path)
+        self.controller.may_arrive = reserved.to_goal and list(hold) == reserved.path[-1]
+        return hold
 
     def _own_state(self, tick: Tick) -> AgvState | None:
         """This AGV's state in ``tick``: at its place in the last tick, else searched."""
@@ -189,7 +221,11 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
 
     Every guard of a run finds the passages for the same clearance, the largest of the
     fleet's, so that a passage id means the same passage to every AGV."""
-    if controller.costmap is None or controller.config.algorithm == "dwa":
+    if (
+        controller.costmap is None
+        or controller.config.algorithm == "dwa"
+        or scenario.traffic == RESERVATIONS
+    ):
         return None
     fleet = [a.config.clearance for a in scenario.agvs]
     widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))

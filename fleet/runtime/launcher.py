@@ -48,6 +48,7 @@ class FleetOptions:
     scenario_arg: str  # what the AGV processes load: a file path or a built-in name
     algorithm: str | None = None
     profile: str | None = None
+    traffic: str | None = None
     realtime: float | None = None
     transport: str = "unix"
     zenoh_config: str | None = None
@@ -78,6 +79,7 @@ def _run_options(options: FleetOptions, endpoint: str, prefix: str) -> list[str]
     for flag, value in (
         ("--algorithm", options.algorithm),
         ("--profile", options.profile),
+        ("--traffic", options.traffic),
         ("--zenoh-config", options.zenoh_config),
     ):
         if value:

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
+from fleet.runtime.reservations import Reservations
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
 from planner.core.motion import limit_command, step_pose
@@ -89,10 +90,12 @@ class World:
         self._refresh_temporary()
         self.ended = False
         self.end_reason = ""
+        self.reservations = Reservations.of(scenario)  # None: the zone rule
 
     # --- the clock ----------------------------------------------------------------
     def first_tick(self) -> Tick:
         self._check_contacts()
+        self._reserve()
         return self._make_tick()
 
     def live_agvs(self) -> list[str]:
@@ -118,7 +121,16 @@ class World:
             self._end(self._done_reason())
         elif self.time >= self.scenario.time_limit - 1e-9:
             self._end("time limit")
-        return None if self.ended else self._make_tick()
+        if self.ended:
+            return None
+        self._reserve()
+        return self._make_tick()
+
+    def _reserve(self) -> None:
+        """Traffic mode "reservations": the schedule's step for this tick (its events too)."""
+        if self.reservations is not None:
+            running = {n: (self.states[n].x, self.states[n].y) for n in self._running()}
+            self.events.extend(self.reservations.update(running, self.tick, self.time))
 
     def _apply(self, name: str, command: AgvCommand) -> None:
         """The world as physics: the command within the AGV's limits, integrated (Eq. 4).
@@ -230,6 +242,9 @@ class World:
 
     # --- internals ----------------------------------------------------------------
     def _finish(self, name: str, status: str, why: str) -> None:
+        if self.reservations is not None:
+            state = self.states[name]
+            self.reservations.finish(name, status, (state.x, state.y))
         record = self.records[name]
         record.status = status
         if status == ARRIVED:
@@ -251,6 +266,7 @@ class World:
             moving=self.moving_obstacles(),
             temporary=[list(c) for c in self._temporary_shown],
             intents=self._claims(),
+            reservations=self.reservations.current if self.reservations is not None else [],
         )
 
     def _claims(self) -> list[Intent]:

@@ -104,6 +104,7 @@ class FusionController:
         self.trail = Trail()  # the way it came: where a head-on walker walks on
         self.mode = Mode.DRIVING
         self.failure = ""
+        self.may_arrive = True  # False: at the goal, but the traffic schedule has it pass on
         self._previous = STOP  # the last cycle's command, for DWA's steadiness term
         self._recovery_started = ""  # in this cycle, for its ControlStep
         self._stalled_before: Point | None = None  # the target the AGV last stalled on
@@ -179,6 +180,15 @@ class FusionController:
         failure they cause."""
         self.plans.park(discs, self.key_nodes.route_ahead() if self.targets else None, labels)
 
+    def fail(self, reason: str) -> None:
+        """End the run as failed for ``reason`` (e.g. the traffic schedule found it cut off)."""
+        self.mode = Mode.FAILED
+        self.failure = reason
+
+    def arrive(self) -> None:
+        """End the run as arrived (a driver other than ``step`` brought it to the goal)."""
+        self.mode = Mode.ARRIVED
+
     def stalled(self, now: float) -> bool:
         """No progress along the route for the progress window (waiting excluded)."""
         return self.progress.stalled(now)
@@ -222,7 +232,7 @@ class FusionController:
         position = (pose[0], pose[1])
         self.trail.note(position)
         # check the goal
-        if self.goal_checker.within(position, self.goal):
+        if self.may_arrive and self.goal_checker.within(position, self.goal):
             if self.goal_checker.is_goal_reached(position, self.goal, command):
                 self.mode = Mode.ARRIVED
                 return _step(STOP, self.mode.value)

@@ -1,0 +1,59 @@
+"""The world's side of traffic mode "reservations": it keeps the fleet's schedule.
+
+Why the world and not every AGV: see ``planner.traffic.schedule``. The world updates
+the schedule once per tick from the states it integrated, hands every running AGV its
+reservation with the tick, and records the schedule's decisions as events
+(``reserved``: nodes released to an AGV; ``waits-for``: an AGV waits for another to
+leave the node it needs next). Both run modes run this same code in the world.
+"""
+
+from __future__ import annotations
+
+import time
+
+from bridge.messages import Event
+from fleet.scenario import RESERVATIONS
+from fleet.toml_schema import ScenarioError
+from planner.core.status import ARRIVED
+from planner.maps.clearance import Clearance
+from planner.maps.costmap import Costmap
+from planner.maps.grid import Point
+from planner.traffic.roadmap import Roadmap
+from planner.traffic.schedule import Reservation, Schedule, ScheduleError
+
+
+class Reservations:
+    def __init__(self, schedule: Schedule):
+        self.schedule = schedule
+        self.current: list[Reservation] = []
+        self.cpu_s = 0.0  # CPU time spent in the schedule, for the benchmarks
+        self.updates = 0
+
+    @classmethod
+    def of(cls, scenario) -> Reservations | None:
+        """The schedule of a scenario in traffic mode "reservations" (None otherwise), on
+        the roadmap of the fleet's widest clearance (one roadmap for every AGV)."""
+        if scenario.traffic != RESERVATIONS:
+            return None
+        fleet = [a.config.clearance for a in scenario.agvs]
+        widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))
+        roadmap = Roadmap.for_costmap(Costmap.for_grid(scenario.grid, widest))
+        agents = [(a.name, a.start, a.goal) for a in scenario.agvs]
+        try:
+            return cls(Schedule(roadmap, agents))
+        except ScheduleError as err:
+            raise ScenarioError(f"[traffic] mode = reservations: {err}") from None
+
+    def update(self, running: dict[str, Point], tick: int, now: float) -> list[Event]:
+        t0 = time.thread_time()  # CPU, not wall time: the machine may be busy
+        self.current = self.schedule.update(running)
+        self.cpu_s += time.thread_time() - t0
+        self.updates += 1
+        return [Event(tick, now, e.kind, e.agvs, e.detail) for e in self.schedule.drain_events()]
+
+    def finish(self, name: str, status: str, position: Point) -> None:
+        """An AGV stopped for good: parked at its goal, or a body the plan goes round."""
+        if status == ARRIVED:
+            self.schedule.arrived(name)
+        else:
+            self.schedule.fail(name, position)
