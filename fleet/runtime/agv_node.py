@@ -75,7 +75,8 @@ class AgvNode:
         start, goal, dwa = self.spec.start, self.spec.goal, self.controller.dwa
         pose, rest, cfg = (*start, 0.0), (0.0, 0.0, 0.0), dwa.config
         self.controller.start(pose)
-        dwa.plan(pose, rest, goal, segment=(start, goal), lane_room=1.0)
+        # reach and stop: the heading critic's pass test and the arrival speed's bound
+        dwa.plan(pose, rest, goal, segment=(start, goal), lane_room=1.0, reach=0.5, stop=True)
         walker = np.array([[*start, 0.0, 0.0, 0.1]])  # the disc and evasion kernels, too
         moving_discs(np.array([[*start, 0.0, 0.0, 0.0, 0.0, cfg.radius]] * 2), 0, walker, cfg.dt)
         dwa.plan(pose, rest, goal, walker)
