@@ -1,5 +1,5 @@
 """The layers of DESIGN.md, checked on the source: imports only run downwards, no import
-circle, no private name used across modules.
+circle, no private name used across modules, and modules small enough to read.
 
 Every import statement counts, wherever it stands (in a function, under TYPE_CHECKING):
 a circle that only type checking closes is still a circle for the reader.
@@ -10,12 +10,15 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGES = ("planner", "bridge", "recordings", "fleet")
 # a package may import those left of it, never those right of it
 PACKAGE_ORDER = ("planner", "bridge", "recordings", "fleet")
 # planner's sub-packages, lowest first: each imports only itself and those before it
 PLANNER_ORDER = ("core", "maps", "route", "local", "traffic", "nav")
+MAX_LINES = 450
 MAX_PLANNER_TOP_MODULES = 8
 
 
@@ -108,6 +111,16 @@ def test_no_private_name_across_modules():
         if n.startswith("_") and target(module, n) != name
     ]
     assert not wrong, "private names imported across modules:\n" + "\n".join(wrong)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_modules_are_small(package):
+    long = {
+        str(p.relative_to(ROOT)): n
+        for name, p in MODULES.items()
+        if name.split(".")[0] == package and (n := len(p.read_text().splitlines())) > MAX_LINES
+    }
+    assert not long, f"modules over {MAX_LINES} lines: {long}"
 
 
 def test_planner_is_sub_packages():
