@@ -11,6 +11,9 @@ the hashes as JSON; ``--compare FILE`` prints which runs differ from that file a
 third of the set (the built-ins, two episodes, two traffic cases) for a quick check.
 
 A restructure keeps every hash; a deliberate behaviour change names the runs it changes.
+``benchmarks/fingerprint-facd495.json`` holds the hashes of commit facd495 (before the
+planner was split into sub-packages); every commit since that meant to keep behaviour
+keeps them, until a deliberate change (then write a new file named after its commit).
 """
 
 from __future__ import annotations

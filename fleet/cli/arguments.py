@@ -11,6 +11,17 @@ class UsageError(BadInputError):
     """Options that cannot go together, found after parsing."""
 
 
+def positive_int(text: str) -> int:
+    """A whole number >= 1 (a count of workers, maps, runs)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
+    return value
+
+
 def positive_float(text: str) -> float:
     """An argparse type: a number > 0."""
     try:

@@ -9,6 +9,7 @@ import time
 from pathlib import Path
 
 from fleet import exit_codes
+from fleet.cli.arguments import positive_int
 
 DEFAULT_OUT = "paper-report"
 RUNS_IN_OUT = "runs"  # the recordings' folder inside --out, unless --runs says otherwise
@@ -40,13 +41,13 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--workers",
-        type=_count,
+        type=positive_int,
         metavar="N",
         help="processes for the walker-timing sweep (default: one per core)",
     )
     p.add_argument(
         "--maps50",
-        type=_count,
+        type=positive_int,
         metavar="N",
         help="seeded 50x50 maps with a path to compare (default 50; 5 with --quick)",
     )
@@ -55,16 +56,6 @@ def add_parsers(sub) -> None:
     )
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run_paper)
-
-
-def _count(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return value
 
 
 def run_paper(args: argparse.Namespace) -> int:

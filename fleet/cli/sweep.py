@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from fleet import exit_codes
-from fleet.cli.arguments import UsageError
+from fleet.cli.arguments import UsageError, positive_int
 
 DEFAULT_OUT = "runs/sweep-{scenario}"
 STATS_CSV = "stats.csv"
@@ -52,7 +52,7 @@ def add_parsers(sub) -> None:
     )
     p.add_argument(
         "--workers",
-        type=_workers,
+        type=positive_int,
         metavar="N",
         help="runs at once on this machine (default: one per core)",
     )
@@ -72,16 +72,6 @@ def add_parsers(sub) -> None:
     p.add_argument("--plots", metavar="DIR", type=Path, help="a box plot per metric into DIR")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress lines")
     p.set_defaults(handler=run_sweep)
-
-
-def _workers(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return value
 
 
 def run_sweep(args: argparse.Namespace) -> int:
