@@ -136,3 +136,15 @@ def test_the_checks_see_a_violation(tmp_path):
     assert rank("planner.core.errors") < rank("planner.maps.grid") < rank("planner.nav.fusion")
     assert rank("planner.nav.fusion") < rank("bridge.messages") < rank("fleet.cli.main")
     assert "planner.maps.grid" in edges()["planner.maps.costmap"]
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists the packages a plain ``pip install .`` ships: a sub-package
+    missing there works in a checkout and the editable install, and fails installed."""
+    import tomllib
+
+    listed = set(
+        tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    )
+    found = {name for name, path in MODULES.items() if path.name == "__init__.py"}
+    assert found - listed == set(), "packages pyproject.toml does not install"
