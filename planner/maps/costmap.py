@@ -66,11 +66,7 @@ class Costmap:
     def for_grid(cls, grid: GridMap, clearance: Clearance) -> Costmap:
         """The costmap of ``grid`` for ``clearance``, built on first use and then cached
         with the map (maps are immutable)."""
-        key = ("costmap", clearance)
-        costmap = grid.cache.get(key)
-        if costmap is None:
-            costmap = grid.cache[key] = cls.build(grid, clearance)
-        return costmap
+        return grid.derived(("costmap", clearance), lambda: cls.build(grid, clearance))
 
     def with_blocked(self, cells) -> Costmap:
         """The costmap of the map plus obstacle cells (col, row): temporary obstacles sensed.

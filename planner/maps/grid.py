@@ -31,7 +31,7 @@ class GridMap:
     name: str = "map"
     origin: tuple[float, float] = (0.0, 0.0)
     _prefix: np.ndarray = field(init=False, repr=False, compare=False)
-    # derived data built once per map (costmaps by clearance): see planner.maps.costmap
+    # derived data built once per map (costmaps, passages, roadmaps by clearance): ``derived``
     cache: dict = field(init=False, repr=False, compare=False, default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -156,6 +156,14 @@ class GridMap:
     def prefix_sums(self) -> np.ndarray:
         """(H+1, W+1) int array: prefix[r, c] = obstacles in rows < r and cols < c."""
         return self._prefix
+
+    def derived(self, key, build):
+        """``build()``, built on first use and then kept with the map under ``key`` (maps
+        are immutable, so every AGV of a run shares what is derived from its map)."""
+        value = self.cache.get(key)
+        if value is None:
+            value = self.cache[key] = build()
+        return value
 
     def with_blocked(self, cells) -> GridMap:
         """A copy with extra obstacle cells (col, row), e.g. temporary obstacles seen so far."""

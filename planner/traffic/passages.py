@@ -89,11 +89,7 @@ class Passages:
     @classmethod
     def for_costmap(cls, costmap: Costmap) -> Passages:
         """The passages of the costmap's map, built on first use and cached with it."""
-        key = ("passages", costmap.clearance)
-        passages = costmap.grid.cache.get(key)
-        if passages is None:
-            passages = costmap.grid.cache[key] = cls.build(costmap)
-        return passages
+        return costmap.grid.derived(("passages", costmap.clearance), lambda: cls.build(costmap))
 
     @classmethod
     def build(cls, costmap: Costmap) -> Passages:

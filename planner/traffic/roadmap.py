@@ -51,11 +51,7 @@ class Roadmap:
     @classmethod
     def for_costmap(cls, costmap: Costmap) -> Roadmap:
         """The roadmap of a costmap, built once and cached with its map."""
-        key = ("roadmap", costmap.clearance)
-        roadmap = costmap.grid.cache.get(key)
-        if roadmap is None:
-            roadmap = costmap.grid.cache[key] = cls.build(costmap)
-        return roadmap
+        return costmap.grid.derived(("roadmap", costmap.clearance), lambda: cls.build(costmap))
 
     @classmethod
     def build(cls, costmap: Costmap) -> Roadmap:
