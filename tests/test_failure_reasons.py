@@ -48,6 +48,7 @@ def test_an_agv_killed_by_a_signal_fails_at_once_and_one_whose_goal_it_holds_nam
     )
     os.kill(agv_pid("a"), signal.SIGKILL)
     out, err = run.communicate(timeout=300)
+    assert out, f"the run printed no summary (exit {run.returncode}): {err}"
     agvs = {a["name"]: a for a in json.loads(out)["agvs"]}
     assert (agvs["a"]["status"], agvs["a"]["failure"]) == ("failed", "killed by signal 9")
     assert "agv-fleet agv a: killed by signal 9" in err
