@@ -192,7 +192,10 @@ def main(argv=None) -> int:
     p.add_argument("--data", type=Path, default=DATA, help=f"MovingAI files (default {DATA})")
     p.add_argument("--suite", choices=(*SUITES, "all"), default="all")
     p.add_argument("--agents", help="comma-separated N (default: 10,25,50,100 / room 10,25)")
-    p.add_argument("--scens", default="6,7,8,9,10", help="which random-K .scen files")
+    p.add_argument(
+        "--scens", default="6,7,8,9,10",
+        help="which .scen files: K for random-K, or a full suffix such as even-7",
+    )  # fmt: skip
     p.add_argument("--traffic", default="reservations", choices=("reservations", "zones"))
     p.add_argument("--time-limit", type=float, default=900.0)
     p.add_argument(
@@ -217,8 +220,7 @@ def main(argv=None) -> int:
 def _bench(args) -> int:
     if args.kill_9:
         map_name = SUITES["warehouse"][0]
-        k = args.scens.split(",")[0]
-        scen = args.data / f"{map_name}-random-{k}.scen"
+        scen = _scen_path(args.data, map_name, args.scens.split(",")[0])
         if not scen.is_file():
             raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")
         scenario = scenario_for(args.data / f"{map_name}.map", scen, args.kill_9, args.time_limit)
@@ -233,7 +235,7 @@ def _bench(args) -> int:
             raise AgvFleetError(f"no {map_path}: give the MovingAI MAPF files with --data DIR")
         agents = [int(n) for n in args.agents.split(",")] if args.agents else DEFAULT_AGENTS[suite]
         for k in args.scens.split(","):
-            scen = args.data / f"{map_name}-random-{k}.scen"
+            scen = _scen_path(args.data, map_name, k)
             if not scen.is_file():
                 raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")
             for n in agents:
@@ -257,6 +259,11 @@ def _bench(args) -> int:
     else:
         _table(rows)
     return 0
+
+
+def _scen_path(data: Path, map_name: str, k: str) -> Path:
+    """``7`` names ``random-7``; ``even-7`` names itself."""
+    return data / f"{map_name}-{'random-' + k if k.isdigit() else k}.scen"
 
 
 def _line(r: dict) -> str:

@@ -2,9 +2,10 @@
 nav2_map_server reads them (its image library: any format, colour averaged to grey,
 alpha averaged in trinary mode, a not fully opaque pixel unknown in scale mode).
 
-The AWS RoboMaker small warehouse (map_rotated.png) is not in the project's data: its
-test is built the same way from Nav2's depot and TurtleBot3 sandbox maps, each written
-as PNG by Pillow and planned on beside its PGM twin.
+The AWS RoboMaker small warehouse ships its map as an RGB PNG (scenarios/maps/, source in
+its README): it must plan exactly as a PGM of the same pixels. Nav2's depot and TurtleBot3
+sandbox maps are also written as PNG, BMP, colour, 16-bit and palette images and read beside
+their PGM originals.
 """
 
 from __future__ import annotations
@@ -94,8 +95,8 @@ def test_an_opaque_alpha_channel_counts_in_trinary_mode_as_in_map_server(tmp_pat
     )
 
 
-def plan_json(map_path: Path) -> dict:
-    args = ["--start", "2.0", "13.8", "--goal", "27.5", "14.0", "--json"]
+def plan_json(map_path: Path, start=(2.0, 13.8), goal=(27.5, 14.0)) -> dict:
+    args = ["--start", *map(str, start), "--goal", *map(str, goal), "--json"]
     done = subprocess.run(
         [*CLI, "plan", str(map_path), *args],
         capture_output=True,
@@ -114,6 +115,27 @@ def test_a_png_map_plans_exactly_as_its_pgm_twin(tmp_path):
     from_png, from_pgm = plan_json(png), plan_json(DATA / "depot.yaml")
     assert from_png == from_pgm
     assert all(plan["found"] for plan in from_png["plans"])
+
+
+AWS = Path(__file__).parents[1] / "scenarios" / "maps" / "aws_small_warehouse.yaml"
+
+
+def test_the_aws_small_warehouse_png_plans_exactly_as_its_pgm_twin(tmp_path):
+    """The twin is written byte by byte as a binary PGM (P5), so it goes through the
+    project's own PGM reader, not Pillow: the two readers must agree on a real RGB PNG."""
+    rgb = np.asarray(Image.open(AWS.with_suffix(".png")))
+    assert rgb.ndim == 3 and (rgb[..., 0] == rgb[..., 2]).all()
+    height, width = rgb.shape[:2]
+    pgm = tmp_path / "aws.pgm"
+    pgm.write_bytes(b"P5\n%d %d\n255\n" % (width, height) + rgb[..., 0].tobytes())
+    yaml = tmp_path / "aws.yaml"
+    yaml.write_text(AWS.read_text().replace("aws_small_warehouse.png", "aws.pgm"))
+    from_png, from_pgm = load_ros_map(AWS), load_ros_map(yaml)
+    assert np.array_equal(from_png.blocked, from_pgm.blocked)
+    assert from_png.blocked.any() and not from_png.blocked.all()
+    plans = [plan_json(path, start=(-3.0, -9.0), goal=(3.55, -2.0)) for path in (AWS, yaml)]
+    assert plans[0] == plans[1]
+    assert all(plan["found"] for plan in plans[0]["plans"])
 
 
 def write_map(folder: Path, image: Image.Image, mode="trinary", negate=0) -> Path:

@@ -16,7 +16,9 @@ from planner.local.config import DwaConfig
 from planner.maps.text_maps import parse_text_grid
 from planner.nav.fusion import FusionConfig, FusionController
 
-FLEET = ("warehouse", "crossing", "corridor", "nav2-depot")
+FLEET = (
+    "warehouse", "crossing", "corridor", "nav2-depot", "aws-small-warehouse", "turtlebot3-world"
+)  # fmt: skip
 PAPER_FUSION = (*(f"paper-temporary-{n}" for n in range(4)), "paper-dynamic")
 
 
