@@ -39,15 +39,17 @@ from planner.maps.random_map import random_map
 from planner.maps.ros_map import UNKNOWN_CHOICES
 from planner.maps.text_maps import parse_text_grid
 from planner.nav.fusion import VARIANTS, FusionConfig
+from planner.traffic.mode_choice import suits_reservations
 
 TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
     "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic",
 )  # fmt: skip
-ZONES, RESERVATIONS = "zones", "reservations"
-TRAFFIC_MODES = (ZONES, RESERVATIONS)
+ZONES, RESERVATIONS, AUTO = "zones", "reservations", "auto"
+TRAFFIC_MODES = (AUTO, ZONES, RESERVATIONS)
 """How AGVs share space: the zone rule (``planner.traffic.zones``: one direction holds a
-passage) or node reservations in time (``planner.traffic.schedule``: PIBT steps)."""
+passage), node reservations in time (``planner.traffic.schedule``: PIBT steps), or the
+one of the two that suits the map and the fleet (``planner.traffic.mode_choice``)."""
 TRAFFIC_KEYS = ("mode",)
 # the control period (s) and the longest run (s): at most 3.6 million ticks, and no
 # run whose clock never reaches its end (a dt of 1e-9 was accepted)
@@ -117,7 +119,18 @@ class Scenario:
     moving: tuple[MovingObstacle, ...]
     source: str
     path: str
-    traffic: str = ZONES  # TRAFFIC_MODES
+    traffic: str = AUTO  # TRAFFIC_MODES, as the scenario or --traffic chose
+
+    @functools.cached_property
+    def traffic_mode(self) -> str:
+        """The mode the run uses: ``traffic``, with ``auto`` decided by
+        ``planner.traffic.mode_choice`` (the same in every process of a run)."""
+        if self.traffic != AUTO:
+            return self.traffic
+        clearances = [a.config.clearance for a in self.agvs]
+        agents = [(a.name, a.start, a.goal) for a in self.agvs]
+        fits = suits_reservations(self.grid, clearances, agents)
+        return RESERVATIONS if fits else ZONES
 
     def __post_init__(self) -> None:
         # dt is the run's one control period: the world steps by it, each AGV's DWA plans
@@ -199,7 +212,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         moving=moving,
         source=text,
         path=str(path) if path else "",
-        traffic=get_str(traffic, "mode", "traffic", default=ZONES, choices=TRAFFIC_MODES),
+        traffic=get_str(traffic, "mode", "traffic", default=AUTO, choices=TRAFFIC_MODES),
     )
 
 

@@ -18,6 +18,8 @@ CLI = [sys.executable, "-m", "fleet.cli"]
 SWAP = """
 name = "swap"
 time_limit = 120
+[traffic]
+mode = "zones"  # the goal-held reason of the zone mode (reservations: "cut off ... by")
 [map]
 grid = '''
 ......................

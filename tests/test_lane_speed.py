@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from fleet.runtime.inprocess import run_in_process
-from fleet.scenario import load_scenario, with_profile
+from fleet.scenario import load_scenario, with_profile, with_traffic
 from planner.core.motion import step_pose
 from planner.local.behaviour import local_behaviour
 from planner.local.config import DwaConfig
@@ -83,7 +83,7 @@ def test_the_route_room_brakes_for_the_next_turn_and_ignores_straight_nodes():
 
 
 def test_the_builtin_corridor_is_faster_than_the_paper_and_passes_in_its_lanes():
-    scenario = load_scenario("corridor")
+    scenario = with_traffic(load_scenario("corridor"), "zones")  # DWA's lanes, not the lattice
     lanes = {agv.name: agv.start[1] for agv in scenario.agvs}
     towards = {"left": 1.0, "right": -1.0}  # left's lane is below right's
     drift = dict.fromkeys(lanes, 0.0)

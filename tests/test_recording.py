@@ -19,7 +19,7 @@ from bridge import keys
 from bridge.bus import encode
 from bridge.messages import AgvState, json_schema
 from fleet.runtime.inprocess import run_in_process
-from fleet.scenario import load_scenario, parse_scenario
+from fleet.scenario import load_scenario, parse_scenario, with_traffic
 from recordings.reader import RecordingError, open_recording
 from recordings.writer import (
     CHUNK_SECONDS,
@@ -33,7 +33,8 @@ REPO = Path(__file__).resolve().parents[1]
 
 def record_run(path: Path, name: str = "corridor"):
     """Record an in-process run of a built-in scenario; also return every message sunk."""
-    scenario = load_scenario(name)
+    # the zone mode's DWA run: long enough (390 ticks) that a cut falls among the commands
+    scenario = with_traffic(load_scenario(name), "zones")
     sunk = []
     with RecordingWriter(
         path,

@@ -317,10 +317,14 @@ def test_replay_errors_exit_with_one_line(corridor, tmp_path, args, message, sta
 def test_a_truncated_recording_replays_what_was_recovered_and_says_so(corridor, tmp_path):
     data = corridor["mcap"].read_bytes()
     cut = tmp_path / "cut.mcap"
-    cut.write_bytes(data[: len(data) // 2])
-    recovered = open_recording(cut)
-    states = recovered.of("agv/left/command")
-    assert 0 < len(states) < len(corridor["recording"].of("agv/left/command"))
+    every = len(corridor["recording"].of("agv/left/command"))
+    for fraction in (2, 3, 4, 6):  # where the commands end depends on what else was recorded
+        cut.write_bytes(data[: len(data) // fraction])
+        recovered = open_recording(cut)
+        states = recovered.of("agv/left/command")
+        if 0 < len(states) < every:
+            break
+    assert 0 < len(states) < every
     out = tmp_path / "cut.rrd"
     done = agv_fleet("replay", str(cut), "--save", str(out))
     assert done.returncode == 0, done.stderr

@@ -105,11 +105,9 @@ def test_one_cell_doors_of_the_mapf_room_map_ten_agents_all_arrive():
     assert summary.success, summary.table()
 
 
-def test_zones_mode_is_the_default_and_bad_modes_are_refused():
-    assert (
-        parse_scenario(shelves_text().replace('[traffic]\nmode = "reservations"\n', "")).traffic
-        == "zones"
-    )
+def test_auto_mode_is_the_default_and_bad_modes_are_refused():
+    default = parse_scenario(shelves_text().replace('[traffic]\nmode = "reservations"\n', ""))
+    assert default.traffic == "auto"
     with pytest.raises(ScenarioError, match="traffic"):
         parse_scenario(shelves_text("queues"))
     with pytest.raises(ScenarioError, match="unknown traffic mode"):

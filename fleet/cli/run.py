@@ -74,7 +74,9 @@ def add_parsers(sub) -> None:
         choices=TRAFFIC_MODES,
         help=(
             "how AGVs share space, instead of the scenario's [traffic] mode: zones (one "
-            "direction holds a passage) or reservations (PIBT node reservations in time)"
+            "direction holds a passage), reservations (PIBT node reservations in time) or "
+            "auto (the default: reservations for two or more AGVs on a map of one body to a "
+            "cell with every start and goal on a cell centre, else zones)"
         ),
     )
     p.add_argument(

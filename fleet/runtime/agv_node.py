@@ -134,7 +134,7 @@ class AgvNode:
 
     def _reservation(self, tick: Tick) -> Reservation | None:
         """This AGV's reservation in ``tick`` (traffic mode "reservations"), else None."""
-        if self.scenario.traffic != RESERVATIONS:
+        if self.scenario.traffic_mode != RESERVATIONS:
             return None
         return next((r for r in tick.reservations if r.name == self.name), None)
 
@@ -224,7 +224,7 @@ def traffic_guard(scenario: Scenario, controller: FusionController) -> TrafficGu
     if (
         controller.costmap is None
         or controller.config.algorithm == "dwa"
-        or scenario.traffic == RESERVATIONS
+        or scenario.traffic_mode == RESERVATIONS
     ):
         return None
     fleet = [a.config.clearance for a in scenario.agvs]

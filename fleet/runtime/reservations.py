@@ -14,9 +14,8 @@ import time
 from bridge.messages import Event
 from fleet.scenario import RESERVATIONS
 from fleet.toml_schema import ScenarioError
+from planner.core.physics import braking_distance
 from planner.core.status import ARRIVED
-from planner.maps.clearance import Clearance
-from planner.maps.costmap import Costmap
 from planner.maps.grid import Point
 from planner.traffic.roadmap import Roadmap
 from planner.traffic.schedule import Reservation, Schedule, ScheduleError
@@ -33,14 +32,13 @@ class Reservations:
     def of(cls, scenario) -> Reservations | None:
         """The schedule of a scenario in traffic mode "reservations" (None otherwise), on
         the roadmap of the fleet's widest clearance (one roadmap for every AGV)."""
-        if scenario.traffic != RESERVATIONS:
+        if scenario.traffic_mode != RESERVATIONS:
             return None
-        fleet = [a.config.clearance for a in scenario.agvs]
-        widest = Clearance(max(c.radius for c in fleet), max(c.margin for c in fleet))
-        roadmap = Roadmap.for_costmap(Costmap.for_grid(scenario.grid, widest))
+        roadmap = Roadmap.for_fleet(scenario.grid, [a.config.clearance for a in scenario.agvs])
         agents = [(a.name, a.start, a.goal) for a in scenario.agvs]
+        stopping = [stopping_distance(a.config.dwa) for a in scenario.agvs]
         try:
-            return cls(Schedule(roadmap, agents))
+            return cls(Schedule(roadmap, agents, stopping))
         except ScheduleError as err:
             raise ScenarioError(f"[traffic] mode = reservations: {err}") from None
 
@@ -57,3 +55,8 @@ class Reservations:
             self.schedule.arrived(name)
         else:
             self.schedule.fail(name, position)
+
+
+def stopping_distance(dwa) -> float:
+    """How far an AGV needs to stop from its top speed (m)."""
+    return braking_distance(dwa.max_speed, dwa.max_accel)

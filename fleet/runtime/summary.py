@@ -40,6 +40,7 @@ class RunSummary:
     collisions: int
     end_reason: str
     agvs: tuple[AgvSummary, ...]
+    traffic: str = ""  # the traffic mode the run used (zones or reservations)
 
     @property
     def success(self) -> bool:
@@ -54,6 +55,7 @@ class RunSummary:
             "ticks": self.ticks,
             "collisions": self.collisions,
             "end_reason": self.end_reason,
+            "traffic": self.traffic,
             "agvs": [
                 {
                     "name": a.name,
@@ -147,6 +149,7 @@ def summarize(world: World, wall_time: float) -> RunSummary:
         collisions=world.collisions,
         end_reason=world.end_reason,
         agvs=tuple(agvs),
+        traffic=world.scenario.traffic_mode,
     )
 
 

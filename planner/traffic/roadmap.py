@@ -24,8 +24,9 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
-from planner.maps.grid import Point
+from planner.maps.grid import GridMap, Point
 
 GAP = 0.1
 """m, the least room between two AGVs on adjacent nodes."""
@@ -54,9 +55,20 @@ class Roadmap:
         return costmap.grid.derived(("roadmap", costmap.clearance), lambda: cls.build(costmap))
 
     @classmethod
+    def for_fleet(cls, grid: GridMap, clearances: list[Clearance]) -> Roadmap:
+        """The one roadmap of a fleet: on the costmap of its widest clearance."""
+        widest = Clearance(max(c.radius for c in clearances), max(c.margin for c in clearances))
+        return cls.for_costmap(Costmap.for_grid(grid, widest))
+
+    @staticmethod
+    def spacing_for(grid: GridMap, radius: float) -> int:
+        """The lattice step (cells) for bodies of ``radius``: see the module docstring."""
+        return max(1, math.ceil((2 * radius + GAP) / grid.resolution - 1e-9))
+
+    @classmethod
     def build(cls, costmap: Costmap) -> Roadmap:
         grid, radius = costmap.grid, costmap.clearance.radius
-        spacing = max(1, math.ceil((2 * radius + GAP) / grid.resolution - 1e-9))
+        spacing = cls.spacing_for(grid, radius)
         fits = ~costmap.lethal
         index = np.full(fits.shape, -1, dtype=np.int32)
         rows, cols = np.nonzero(fits[::spacing, ::spacing])

@@ -17,13 +17,16 @@ Each update:
    plan froze it there when it planned it onto its goal); one that failed (or died)
    becomes a body on the nodes it covers, and every AGV's plan beyond its released
    nodes is planned again round it.
-3. Planning ahead: while an AGV has fewer than ``LOOKAHEAD`` nodes planned beyond the
-   one it reached, and the plan runs less than ``HORIZON`` steps ahead of the AGV
+3. Planning ahead: while an AGV has fewer nodes planned beyond the one it reached than
+   it may hold (step 4), and the plan runs less than ``HORIZON`` steps ahead of the AGV
    furthest behind, one more PIBT step (``planner.traffic.pibt``) for all agents not
    yet at their goals. An agent planned onto its goal is frozen there: a fixed node
    for the others from then on (an AGV parks for good when it arrives).
 4. Release: each AGV gets up to ``RELEASE`` nodes ahead of the one it reached whose
-   earlier visits are done; the first one it does not get names whom it waits for.
+   earlier visits are done, or as many as it needs to stop in from its top speed if that
+   is more (it drives on the braking curve to the last node it holds: with fewer, a fast
+   AGV would brake towards each next node and saw-tooth at cruise); the first node it
+   does not get names whom it waits for.
 
 An AGV whose goal no way on the roadmap reaches any more (bodies stopped for good cut
 it off) is told so, with the names of the bodies on its shortest way (``blocked_by``).
@@ -41,11 +44,9 @@ from planner.traffic import pibt
 from planner.traffic.precedence import Precedence
 from planner.traffic.roadmap import GAP, UNREACHABLE, Roadmap
 
-LOOKAHEAD = 4
-"""Plan steps kept planned beyond the node an AGV has reached (braking from full speed
-takes about two nodes on a 1 m lattice at 0.5 m/s²)."""
 RELEASE = 4
-"""Nodes an AGV may hold ahead of the one it has reached."""
+"""Nodes an AGV may hold ahead of the one it has reached, at least (braking from 1 m/s
+takes one node on a 1 m lattice at 0.5 m/s²); more for an AGV that needs them to stop."""
 HORIZON = 20
 """The plan runs at most this many steps ahead of the AGV furthest behind: a longer plan
 only adds waits for that AGV."""
@@ -83,10 +84,20 @@ EVENT_KINDS = (RESERVED, WAITS_FOR)
 
 
 class Schedule:
-    def __init__(self, roadmap: Roadmap, agents: list[tuple[str, Point, Point]]):
-        """``agents``: (name, start, goal) of every AGV, in the fleet's order."""
+    def __init__(
+        self,
+        roadmap: Roadmap,
+        agents: list[tuple[str, Point, Point]],
+        stopping: list[float] | None = None,
+    ):
+        """``agents``: (name, start, goal) of every AGV, in the fleet's order;
+        ``stopping``: each one's braking distance from its top speed (m, default 0)."""
         self.roadmap = roadmap
         self.names = [a[0] for a in agents]
+        step = roadmap.spacing * roadmap.costmap.grid.resolution
+        self.holds = [
+            max(RELEASE, 1 + math.ceil(d / step - 1e-9)) for d in stopping or [0.0] * len(agents)
+        ]
         self.goal_points = [tuple(a[2]) for a in agents]
         starts = [self._node(name, start, "start") for name, start, _ in agents]
         self.goals = [self._node(name, goal, "goal") for name, _, goal in agents]
@@ -207,7 +218,7 @@ class Schedule:
             last = len(plan.nodes[agent]) - 1
             if plan.progress[agent] < last:
                 behind = min(behind, plan.steps[agent][plan.progress[agent] + 1] - 1)
-            if agent not in self.frozen and last - plan.progress[agent] < LOOKAHEAD:
+            if agent not in self.frozen and last - plan.progress[agent] < self.holds[agent]:
                 short = short or not self._cut_off(agent)
         return short and self.step - behind < HORIZON
 
@@ -261,7 +272,7 @@ class Schedule:
 
     def _reserve(self, agent: int) -> Reservation:
         plan, name = self.plan, self.names[agent]
-        count, blocker = plan.release(agent, RELEASE)
+        count, blocker = plan.release(agent, self.holds[agent])
         nodes = plan.nodes[agent][plan.progress[agent] : plan.released[agent] + 1]
         path = [[round(float(v), 3) for v in self.roadmap.centres[n]] for n in nodes]
         to_goal = agent in self.frozen and plan.released[agent] == len(plan.nodes[agent]) - 1
