@@ -47,7 +47,7 @@ from benchmarks.bus_floor import bus_floor_ticks_per_s
 from benchmarks.fleet_maps import LAYOUTS, scenario_text
 from bridge import keys
 from bridge.bus import decode
-from bridge.messages import encode
+from bridge.wire import to_wire
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.launcher import FleetOptions, run_fleet
 from fleet.runtime.world import World
@@ -120,10 +120,11 @@ def cpu_split(before: CpuSnapshot, after: CpuSnapshot, world_pid: int) -> tuple[
 
 
 def tick_load(world: World) -> tuple[float, float]:
-    """KB and ms of decoding per tick: the tick as the AGVs receive it, over all of them."""
+    """KB and ms of decoding per tick: the tick as the AGVs receive it on the bus, over all
+    of them."""
     tick = world.final_tick()
     tick.final = False
-    payload = encode(tick)
+    payload = to_wire(keys.WORLD_TICK, tick)
     times = []
     for _ in range(DECODE_REPEATS):
         start = time.perf_counter()
