@@ -1,8 +1,8 @@
 """The fleet over Zenoh against in process, side by side: 50 to 200 AGVs on two maps.
 
 ``python benchmarks/fleet_bench.py [--maps sparse,dense] [--sizes 50,100,200]
-[--sim-time 12] [--runs 1] [--zenoh-only]`` (from the repository root). The maps are
-``benchmarks/fleet_maps.py``'s: a sparse 128 x 80 m and a dense 64 x 40 m warehouse,
+[--sim-time 12] [--runs 1] [--zenoh-only] [--shared-memory]`` (from the repository root). The
+maps are ``benchmarks/fleet_maps.py``'s: a sparse 128 x 80 m and a dense 64 x 40 m warehouse,
 the AGVs crossing from docks on one side to the other. Each run is cut at ``--sim-time``
 seconds of simulated time. Per map and fleet size, the same scenario:
 
@@ -47,6 +47,7 @@ from benchmarks.bus_floor import bus_floor_ticks_per_s
 from benchmarks.fleet_maps import LAYOUTS, scenario_text
 from bridge import keys
 from bridge.bus import decode
+from bridge.session import SHARED_MEMORY_ENV, shared_memory
 from bridge.wire import to_wire
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.launcher import FleetOptions, run_fleet
@@ -289,13 +290,22 @@ def main() -> None:
     parser.add_argument(
         "--runs", type=int, default=1, help="Zenoh runs per size; the median run is reported"
     )
+    parser.add_argument(
+        "--shared-memory", action="store_true", help="Zenoh's shared memory on (floor and runs)"
+    )
     args = parser.parse_args()
+    if args.shared_memory:  # inherited by every process the runs start
+        os.environ[SHARED_MEMORY_ENV] = "1"
     maps = args.maps.split(",")
     if args.runs < 1 or any(m not in LAYOUTS for m in maps):
         parser.error(f"--runs must be at least 1; --maps among {', '.join(LAYOUTS)}")
     started = time.monotonic()
     layouts = ", ".join(f"{m} {LAYOUTS[m].width}x{LAYOUTS[m].height} m" for m in maps)
-    print(f"fleet_bench: {layouts}; {args.sim_time:g} s simulated, warm from tick {WARM_FROM}")
+    memory = "on" if shared_memory() else "off"
+    print(
+        f"fleet_bench: {layouts}; {args.sim_time:g} s simulated, warm from tick {WARM_FROM}; "
+        f"Zenoh shared memory {memory}"
+    )
     print(HEADER)
     print("-" * len(HEADER))
     verdicts: list = []
