@@ -140,6 +140,7 @@ class Clock:
     """What a run's progress callback sees: when ticks were done, CPU, memory."""
 
     zenoh: bool
+    cpu_to: int  # the last tick before the time limit: every AGV process still runs
     start: float = field(default_factory=time.monotonic)
     times: dict[int, float] = field(default_factory=dict)
     last_tick: int = -1
@@ -153,7 +154,7 @@ class Clock:
         k = world.tick
         self.times.setdefault(k, time.monotonic())
         self.last_tick = k
-        if k == WARM_FROM or world.ended:
+        if k in (WARM_FROM, self.cpu_to):
             if self.zenoh:
                 self.cpu[k] = cpu_snapshot(os.getpid())
             else:
@@ -177,14 +178,16 @@ class Clock:
         span = self.times[self.last_tick] - self.times[WARM_FROM]
         return (self.last_tick - WARM_FROM) / span if span > 0 else float("nan")
 
-    def cpu_ms_per_tick(self) -> tuple[float, ...]:
+    def cpu_ms_per_tick(self) -> tuple[float, ...] | None:
         """Warm ticks: over Zenoh (AGV main threads, AGV other threads, world); in process
-        (the whole process,)."""
-        span = self.last_tick - WARM_FROM
-        if self.zenoh:
-            split = cpu_split(self.cpu[WARM_FROM], self.cpu[self.last_tick], os.getpid())
+        (the whole process,). None: the run ended before ``cpu_to`` (every AGV arrived)."""
+        span = self.cpu_to - WARM_FROM
+        if self.zenoh and self.cpu_to in self.cpu:
+            split = cpu_split(self.cpu[WARM_FROM], self.cpu[self.cpu_to], os.getpid())
+        elif not self.zenoh and self.cpu_to in self.process_cpu:
+            split = (self.process_cpu[self.cpu_to] - self.process_cpu[WARM_FROM],)
         else:
-            split = (self.process_cpu[self.last_tick] - self.process_cpu[WARM_FROM],)
+            return None
         return tuple(seconds * 1e3 / span for seconds in split)
 
 
@@ -208,11 +211,18 @@ def measured(run, clock: Clock) -> Outcome:
     return Outcome(clock, arrived, summary.collisions)
 
 
+def last_tick_before_the_limit(scenario) -> int:
+    return round(scenario.time_limit / scenario.dt) - 1
+
+
 def zenoh_median(scenario, path: Path, runs: int) -> Outcome:
     """The median of ``runs`` Zenoh runs by warm ticks/s (each run's rate printed when
     there are several); a failed run counts as the slowest."""
     outcomes = [
-        measured(partial(run_fleet, scenario, FleetOptions(str(path))), Clock(True))
+        measured(
+            partial(run_fleet, scenario, FleetOptions(str(path))),
+            Clock(True, last_tick_before_the_limit(scenario)),
+        )
         for _ in range(runs)
     ]
     outcomes.sort(key=lambda o: o.clock.warm_ticks_per_s if o.clock else -1.0)
@@ -257,7 +267,7 @@ def report(map_name, size, local: Outcome, bus: Outcome, floor, floor_problem, v
             print(f"{'':>12}{mode}: not measured: {outcome.problem}")
     if floor_problem:
         print(f"{'':>12}bus floor: not measured: {floor_problem}")
-    if lc and bc:
+    if lc and bc and lc.cpu_ms_per_tick() and bc.cpu_ms_per_tick():
         (whole,) = lc.cpu_ms_per_tick()
         steps, receiving, world = bc.cpu_ms_per_tick()
         print(
@@ -265,6 +275,9 @@ def report(map_name, size, local: Outcome, bus: Outcome, floor, floor_problem, v
             f"threads {steps:.1f} ms ({steps / size:.2f} per AGV), AGV receiving "
             f"{receiving:.1f} ms, world {world:.1f} ms, sum {steps + receiving + world:.1f} ms"
         )
+    elif lc and bc:
+        print(f"{'':>12}CPU per warm tick: not measured (the run ended before the time limit)")
+    if lc and bc:
         print(
             f"{'':>12}arrived by the cut: in process {local.arrived}/{size}, over Zenoh "
             f"{bus.arrived}/{size}; collisions {local.collisions} / {bus.collisions}"
@@ -317,7 +330,10 @@ def main() -> None:
                 scenario = load_scenario(path)
                 local = Outcome(problem="skipped (--zenoh-only)")
                 if not args.zenoh_only:
-                    local = measured(partial(run_in_process, scenario), Clock(False))
+                    local = measured(
+                        partial(run_in_process, scenario),
+                        Clock(False, last_tick_before_the_limit(scenario)),
+                    )
                 floor, floor_problem = floor_rate(scenario)
                 bus = zenoh_median(scenario, path, args.runs)
                 report(map_name, size, local, bus, floor, floor_problem, verdicts)
