@@ -33,7 +33,7 @@ from numba.core.registry import CPUDispatcher
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from benchmarks.fleet_bench import scenario_text
+from benchmarks.fleet_maps import warehouse_text as scenario_text
 from fleet.runtime.agv_node import AgvNode
 from fleet.runtime.lockstep import run_lockstep
 from fleet.runtime.world import World

@@ -30,7 +30,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from benchmarks.fleet_bench import scenario_text as warehouse_text  # noqa: E402
+from benchmarks.fleet_maps import warehouse_text  # noqa: E402
 from benchmarks.nav_episodes import make_episode  # noqa: E402
 from benchmarks.traffic_cases import make_case  # noqa: E402
 from fleet.builtin import builtin_scenarios  # noqa: E402

@@ -1,57 +1,64 @@
-"""Ticks per second and memory of the fleet with 5 to 100 AGVs: over Zenoh and in process.
+"""The fleet over Zenoh against in process, side by side: 50 to 200 AGVs on two maps.
 
-A 60 x 40 m warehouse (shelf rows, 3 m aisles, cross aisles) with AGVs
-starting in docks on both sides and crossing to the other. Each run is cut
-at ``--sim-time`` seconds of simulated time. Reported per fleet size:
+``python benchmarks/fleet_bench.py [--maps sparse,dense] [--sizes 50,100,200]
+[--sim-time 12] [--runs 1] [--zenoh-only] [--shared-memory]`` (from the repository root). The
+maps are ``benchmarks/fleet_maps.py``'s: a sparse 128 x 80 m and a dense 64 x 40 m warehouse,
+the AGVs crossing from docks on one side to the other. Each run is cut at ``--sim-time``
+seconds of simulated time. Per map and fleet size, the same scenario:
 
-- ticks/s of the lockstep clock, planning included (first to last tick), for
-  the Zenoh mode (a world router and one process per AGV) and the in-process
-  mode (the baseline: the same world and AGV step code, no bus);
-- the bus floor (``bus_floor.py``): ticks/s over Zenoh of AGV processes that
-  answer every tick at once without planning, and the Zenoh mode's share of it.
-  A run over Zenoh cannot be faster than its floor on the same machine;
-- start-up: from the launch until the first tick is done (all AGV processes
-  forked, connected and answering);
-- memory: the proportional set size (PSS, from /proc/PID/smaps_rollup: shared
-  pages split between the processes that share them) of the AGV host and its
-  AGV processes, per AGV, and of the world (this process), at tick 100;
-- where the CPU goes over Zenoh, in ms per tick from tick 100 to 200 (from
-  /proc/PID/task/TID/stat): the AGV processes' main threads (the step and
-  publishing its answer), their other threads (receiving and decoding the tick:
-  the subscriber's Python thread and Zenoh's), and the world process. Their sum
-  over the cores is the least time a tick can take.
+- in process (the baseline: the same world and AGV step code, no bus) and over Zenoh (a
+  world router and one process per AGV): *warm* ticks/s, from tick ``WARM_FROM`` to the
+  last one, and their ratio; the cold start apart: start-up (from the launch until the
+  first tick is done) and the time of the first ``WARM_FROM`` ticks;
+- the bus floor (``bus_floor.py``): ticks/s over Zenoh of AGV processes that answer every
+  tick at once without planning. A run over Zenoh cannot be faster than its floor;
+- bytes of the world's ticks per tick (the tick as each AGV receives it, summed over the
+  AGVs) and the CPU to decode them (``bridge.bus.decode`` in this process, summed);
+- CPU per warm tick, from /proc: in process the whole process; over Zenoh the AGV
+  processes' main threads (the step and publishing its answer), their other threads
+  (receiving and decoding the tick: the subscriber's Python thread and Zenoh's), and the
+  world process. These are robust to other load on the machine, ticks/s are not;
+- memory: PSS (``/proc/PID/smaps_rollup``: shared pages split between the processes that
+  share them) per AGV of the AGV host and its AGV processes, and of the world, at tick
+  ``PSS_AT_TICK``.
 
-This VM's speed drifts by up to 2x within minutes: ``--runs N`` repeats each Zenoh
-run N times, prints every run's ticks/s, and reports (and judges the targets on) the
-median run (of an even N, the slower of the two middle ones).
+A run that fails says so in one line ("not measured: ...") and the bench goes on.
+``--runs N`` repeats each Zenoh run N times and reports the median by warm ticks/s.
 
-Targets: 50 AGVs at >= 20 ticks/s (2x real time at 10 Hz), 100 AGVs at >= 10
-ticks/s (real time), start-up of 50 AGVs < 5 s.
-
-Run from the repository root: ``python benchmarks/fleet_bench.py``.
+Targets (issue 42): warm Zenoh >= 1.5x in process at 50 and 100 AGVs on both maps; 200
+AGVs run; start-up of 100 AGVs < 5 s; PSS <= 15 MiB per AGV.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import statistics
 import sys
 import tempfile
 import time
+from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from benchmarks.bus_floor import bus_floor_ticks_per_s
+from benchmarks.fleet_maps import LAYOUTS, scenario_text
+from bridge import keys
+from bridge.bus import decode
+from bridge.session import SHARED_MEMORY_ENV, shared_memory
+from bridge.wire import to_wire
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.launcher import FleetOptions, run_fleet
+from fleet.runtime.world import World
 from fleet.scenario import load_scenario
 from planner.core.status import ARRIVED
 
-WIDTH, HEIGHT = 60, 40
-PSS_AT_TICK = 100
-CPU_FROM, CPU_TO = 100, 200  # ticks between which the CPU per tick is measured
+WARM_FROM = 30  # ticks before this are the cold start: not in the warm ticks/s
+PSS_AT_TICK = 40
 TICKS_PER_S = os.sysconf("SC_CLK_TCK")
+DECODE_REPEATS = 5
 
 
 def pss_kib(pid: int) -> int:
@@ -113,155 +120,226 @@ def cpu_split(before: CpuSnapshot, after: CpuSnapshot, world_pid: int) -> tuple[
     return agv_main, agv_other, world
 
 
-def warehouse_grid() -> str:
-    rows = [["."] * WIDTH for _ in range(HEIGHT)]  # rows[0] is the bottom row
-    for y0 in range(5, HEIGHT - 5, 5):
-        for y in (y0, y0 + 1):
-            for x in range(8, WIDTH - 8):
-                if (x - 8) % 12 not in (9, 10, 11):  # cross aisles every 12 m
-                    rows[y][x] = "#"
-    return "\n".join("".join(r) for r in reversed(rows))
+def tick_load(world: World) -> tuple[float, float]:
+    """KB and ms of decoding per tick: the tick as the AGVs receive it on the bus, over all
+    of them."""
+    tick = world.final_tick()
+    tick.final = False
+    payload = to_wire(keys.WORLD_TICK, tick)
+    times = []
+    for _ in range(DECODE_REPEATS):
+        start = time.perf_counter()
+        decode(keys.WORLD_TICK, payload)
+        times.append(time.perf_counter() - start)
+    receivers = len(world.live_agvs())
+    return len(payload) * receivers / 1e3, statistics.median(times) * receivers * 1e3
 
 
-def scenario_text(agvs: int, sim_time: float) -> str:
-    docks = [(x + 0.5, y + 0.5) for y in range(1, HEIGHT - 1, 2) for x in (1, 3, 5)]
-    lines = [
-        f'name = "bench-warehouse-{agvs}"',
-        f"time_limit = {sim_time}",
-        "[map]",
-        f'grid = """\n{warehouse_grid()}\n"""',
-    ]
-    for i in range(agvs):
-        x, y = docks[(i // 2) % len(docks)]
-        start, goal = (
-            ((x, y), (WIDTH - x, HEIGHT - y)) if i % 2 == 0 else ((WIDTH - x, y), (x, HEIGHT - y))
-        )
-        lines += [
-            "[[agvs]]",
-            f'name = "agv{i + 1}"',
-            f"start = [{start[0]}, {start[1]}]",
-            f"goal = [{goal[0]}, {goal[1]}]",
-            f"heading = {0 if i % 2 == 0 else 180}",
-        ]
-    return "\n".join(lines) + "\n"
-
-
+@dataclass
 class Clock:
-    """Records when the first and the last tick were done."""
+    """What a run's progress callback sees: when ticks were done, CPU, memory."""
 
-    def __init__(self):
-        self.start = time.monotonic()
-        self.first = self.last = None
-        self.ticks = 0
-        self.world_pss = self.agvs_pss = 0
-        self.cpu: dict[int, CpuSnapshot] = {}
+    zenoh: bool
+    cpu_to: int  # the last tick before the time limit: every AGV process still runs
+    start: float = field(default_factory=time.monotonic)
+    times: dict[int, float] = field(default_factory=dict)
+    last_tick: int = -1
+    cpu: dict[int, CpuSnapshot] = field(default_factory=dict)
+    process_cpu: dict[int, float] = field(default_factory=dict)
+    world_pss: int = 0
+    agvs_pss: int = 0
+    load: tuple[float, float] | None = None  # KB and decode ms per tick
 
-    def __call__(self, world) -> None:
-        now = time.monotonic()
-        if self.first is None:
-            self.first = now
-            self.first_tick = world.tick
-        self.last, self.ticks = now, world.tick
-        if world.tick == PSS_AT_TICK:
+    def __call__(self, world: World) -> None:
+        k = world.tick
+        self.times.setdefault(k, time.monotonic())
+        self.last_tick = k
+        if k in (WARM_FROM, self.cpu_to):
+            if self.zenoh:
+                self.cpu[k] = cpu_snapshot(os.getpid())
+            else:
+                self.process_cpu[k] = time.process_time()
+        if k == PSS_AT_TICK:
             self.world_pss = pss_kib(os.getpid())
             self.agvs_pss = sum(pss_kib(p) for p in descendants(os.getpid()))
-        if world.tick in (CPU_FROM, CPU_TO):
-            self.cpu[world.tick] = cpu_snapshot(os.getpid())
-
-    @property
-    def cpu_ms_per_tick(self) -> tuple[float, ...] | None:
-        """AGV main threads, AGV other threads, world: ms of CPU per tick (None: the run
-        ended before ``CPU_TO``)."""
-        if CPU_TO not in self.cpu:
-            return None
-        span = CPU_TO - CPU_FROM
-        split = cpu_split(self.cpu[CPU_FROM], self.cpu[CPU_TO], os.getpid())
-        return tuple(seconds * 1e3 / span for seconds in split)
-
-    @property
-    def ticks_per_s(self) -> float:
-        span = self.last - self.first
-        return (self.ticks - self.first_tick) / span if span > 0 else float("nan")
+            if not self.zenoh:
+                self.load = tick_load(world)
 
     @property
     def start_up(self) -> float:
-        return self.first - self.start
+        return self.times[min(self.times)] - self.start
+
+    @property
+    def cold_s(self) -> float:
+        return self.times[WARM_FROM] - self.times[min(self.times)]
+
+    @property
+    def warm_ticks_per_s(self) -> float:
+        span = self.times[self.last_tick] - self.times[WARM_FROM]
+        return (self.last_tick - WARM_FROM) / span if span > 0 else float("nan")
+
+    def cpu_ms_per_tick(self) -> tuple[float, ...] | None:
+        """Warm ticks: over Zenoh (AGV main threads, AGV other threads, world); in process
+        (the whole process,). None: the run ended before ``cpu_to`` (every AGV arrived)."""
+        span = self.cpu_to - WARM_FROM
+        if self.zenoh and self.cpu_to in self.cpu:
+            split = cpu_split(self.cpu[WARM_FROM], self.cpu[self.cpu_to], os.getpid())
+        elif not self.zenoh and self.cpu_to in self.process_cpu:
+            split = (self.process_cpu[self.cpu_to] - self.process_cpu[WARM_FROM],)
+        else:
+            return None
+        return tuple(seconds * 1e3 / span for seconds in split)
 
 
-def median_run(scenario, path: Path, runs: int):
-    """The Clock and summary of the median of ``runs`` Zenoh runs by ticks/s (each run's
-    rate printed when there are several)."""
-    results = []
-    for _ in range(runs):
-        clock = Clock()
-        summary = run_fleet(scenario, FleetOptions(scenario_arg=str(path)), progress=clock)
-        results.append((clock.ticks_per_s, clock, summary))
-    results.sort(key=lambda result: result[0])
+@dataclass
+class Outcome:
+    clock: Clock | None = None
+    arrived: int = 0
+    collisions: int = 0
+    problem: str = ""  # why it was not measured
+
+
+def measured(run, clock: Clock) -> Outcome:
+    """``run(progress=clock)``; what went wrong in one line."""
+    try:
+        summary = run(progress=clock)
+    except Exception as err:  # a bench reports any failure and goes on
+        return Outcome(problem=f"{type(err).__name__}: {err}".splitlines()[0])
+    if clock.last_tick <= WARM_FROM:
+        return Outcome(problem=f"the run ended at tick {clock.last_tick}, before the warm ticks")
+    arrived = sum(a.status == ARRIVED for a in summary.agvs)
+    return Outcome(clock, arrived, summary.collisions)
+
+
+def last_tick_before_the_limit(scenario) -> int:
+    return round(scenario.time_limit / scenario.dt) - 1
+
+
+def zenoh_median(scenario, path: Path, runs: int) -> Outcome:
+    """The median of ``runs`` Zenoh runs by warm ticks/s (each run's rate printed when
+    there are several); a failed run counts as the slowest."""
+    outcomes = [
+        measured(
+            partial(run_fleet, scenario, FleetOptions(str(path))),
+            Clock(True, last_tick_before_the_limit(scenario)),
+        )
+        for _ in range(runs)
+    ]
+    outcomes.sort(key=lambda o: o.clock.warm_ticks_per_s if o.clock else -1.0)
     if runs > 1:
-        rates = ", ".join(f"{rate:.1f}" for rate, _, _ in results)
-        print(f"{scenario.name}: {runs} Zenoh runs, ticks/s {rates}")
-    _, clock, summary = results[(runs - 1) // 2]
-    return clock, summary
+        rates = ", ".join(f"{o.clock.warm_ticks_per_s:.1f}" if o.clock else "-" for o in outcomes)
+        print(f"  {scenario.name}: {runs} Zenoh runs, warm ticks/s {rates}")
+    return outcomes[(runs - 1) // 2]  # of an even N, the slower middle one
+
+
+def floor_rate(scenario) -> tuple[float | None, str]:
+    try:
+        return bus_floor_ticks_per_s(World(scenario).first_tick(), scenario.dt), ""
+    except Exception as err:  # a bench reports any failure and goes on
+        return None, f"{type(err).__name__}: {err}".splitlines()[0]
+
+
+def fmt(value: float | None, width: int, digits: int = 1) -> str:
+    return f"{'-':>{width}}" if value is None else f"{value:>{width}.{digits}f}"
+
+
+HEADER = (
+    f"{'map':>6} {'AGVs':>4}  {'in-proc t/s':>11}  {'zenoh t/s':>9}  {'zenoh/in-proc':>13}  "
+    f"{'floor t/s':>9}  {'start-up s':>10}  {'cold s':>6}  {'PSS/AGV MiB':>11}  "
+    f"{'world MiB':>9}  {'KB/tick':>8}  {'decode ms/tick':>14}"
+)
+
+
+def report(map_name, size, local: Outcome, bus: Outcome, floor, floor_problem, verdicts):
+    lc, bc = local.clock, bus.clock
+    local_rate = lc.warm_ticks_per_s if lc else None
+    bus_rate = bc.warm_ticks_per_s if bc else None
+    ratio = bus_rate / local_rate if lc and bc else None
+    load = lc.load if lc and lc.load else (None, None)
+    print(
+        f"{map_name:>6} {size:>4}  {fmt(local_rate, 11)}  {fmt(bus_rate, 9)}  "
+        f"{fmt(ratio, 13, 2)}  {fmt(floor, 9)}  {fmt(bc and bc.start_up, 10, 2)}  "
+        f"{fmt(bc and bc.cold_s, 6)}  {fmt(bc and bc.agvs_pss / size / 1024, 11)}  "
+        f"{fmt(bc and bc.world_pss / 1024, 9)}  {fmt(load[0], 8)}  {fmt(load[1], 14, 2)}"
+    )
+    for mode, outcome in (("in process", local), ("over Zenoh", bus)):
+        if outcome.problem:
+            print(f"{'':>12}{mode}: not measured: {outcome.problem}")
+    if floor_problem:
+        print(f"{'':>12}bus floor: not measured: {floor_problem}")
+    if lc and bc and lc.cpu_ms_per_tick() and bc.cpu_ms_per_tick():
+        (whole,) = lc.cpu_ms_per_tick()
+        steps, receiving, world = bc.cpu_ms_per_tick()
+        print(
+            f"{'':>12}CPU per warm tick: in process {whole:.1f} ms; over Zenoh AGV main "
+            f"threads {steps:.1f} ms ({steps / size:.2f} per AGV), AGV receiving "
+            f"{receiving:.1f} ms, world {world:.1f} ms, sum {steps + receiving + world:.1f} ms"
+        )
+    elif lc and bc:
+        print(f"{'':>12}CPU per warm tick: not measured (the run ended before the time limit)")
+    if lc and bc:
+        print(
+            f"{'':>12}arrived by the cut: in process {local.arrived}/{size}, over Zenoh "
+            f"{bus.arrived}/{size}; collisions {local.collisions} / {bus.collisions}"
+        )
+    if size in (50, 100):
+        ok = ratio is not None and ratio >= 1.5
+        verdicts.append((ok, f"{map_name} {size} AGVs: warm Zenoh/in process >= 1.5", ratio))
+    if size == 200:
+        verdicts.append((bc is not None, f"{map_name} 200 AGVs run over Zenoh", bus_rate))
+    if size == 100 and bc:
+        verdicts.append((bc.start_up < 5, f"{map_name} start-up of 100 AGVs < 5 s", bc.start_up))
+    if bc:
+        pss = bc.agvs_pss / size / 1024
+        verdicts.append((pss <= 15, f"{map_name} {size} AGVs: PSS <= 15 MiB per AGV", pss))
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--sizes", default="5,20,50,100")
+    parser.add_argument("--maps", default="sparse,dense")
+    parser.add_argument("--sizes", default="50,100,200")
     parser.add_argument("--zenoh-only", action="store_true", help="skip the in-process runs")
-    parser.add_argument("--sim-time", type=float, default=30.0, help="simulated seconds per run")
+    parser.add_argument("--sim-time", type=float, default=12.0, help="simulated s per run")
     parser.add_argument(
         "--runs", type=int, default=1, help="Zenoh runs per size; the median run is reported"
     )
-    args = parser.parse_args()
-    if args.runs < 1:
-        parser.error("--runs must be at least 1")
-    print(f"fleet_bench: {WIDTH}x{HEIGHT} m warehouse, {args.sim_time:g} s simulated per run")
-    header = (
-        f"{'AGVs':>5}  {'in-process t/s':>14}  {'zenoh t/s':>9}  {'zenoh/in-process':>16}  "
-        f"{'floor t/s':>9}  {'zenoh/floor':>11}  "
-        f"{'start-up s':>10}  {'PSS/AGV MiB':>11}  {'world MiB':>9}  arrived/collisions (zenoh)"
+    parser.add_argument(
+        "--shared-memory", action="store_true", help="Zenoh's shared memory on (floor and runs)"
     )
-    print(header)
-    print("-" * len(header))
-    verdicts = []
+    args = parser.parse_args()
+    if args.shared_memory:  # inherited by every process the runs start
+        os.environ[SHARED_MEMORY_ENV] = "1"
+    maps = args.maps.split(",")
+    if args.runs < 1 or any(m not in LAYOUTS for m in maps):
+        parser.error(f"--runs must be at least 1; --maps among {', '.join(LAYOUTS)}")
+    started = time.monotonic()
+    layouts = ", ".join(f"{m} {LAYOUTS[m].width}x{LAYOUTS[m].height} m" for m in maps)
+    memory = "on" if shared_memory() else "off"
+    print(
+        f"fleet_bench: {layouts}; {args.sim_time:g} s simulated, warm from tick {WARM_FROM}; "
+        f"Zenoh shared memory {memory}"
+    )
+    print(HEADER)
+    print("-" * len(HEADER))
+    verdicts: list = []
     with tempfile.TemporaryDirectory() as folder:
-        for size in (int(s) for s in args.sizes.split(",")):
-            path = Path(folder) / f"bench-{size}.toml"
-            path.write_text(scenario_text(size, args.sim_time))
-            scenario = load_scenario(path)
-            local = Clock()
-            if not args.zenoh_only:
-                run_in_process(scenario, progress=local)
-            floor = bus_floor_ticks_per_s(scenario)
-            bus, summary = median_run(scenario, path, args.runs)
-            arrived = sum(a.status == ARRIVED for a in summary.agvs)
-            local_rate = float("nan") if args.zenoh_only else local.ticks_per_s
-            print(
-                f"{size:>5}  {local_rate:>14.1f}  {bus.ticks_per_s:>9.1f}  "
-                f"{bus.ticks_per_s / local_rate:>16.2f}  {floor:>9.1f}  "
-                f"{bus.ticks_per_s / floor:>11.2f}  {bus.start_up:>10.2f}  "
-                f"{bus.agvs_pss / size / 1024:>11.1f}  {bus.world_pss / 1024:>9.1f}  "
-                f"{arrived}/{size} arrived by {args.sim_time:g} s, {summary.collisions} collisions"
-            )
-            if bus.cpu_ms_per_tick is not None:
-                steps, receiving, world = bus.cpu_ms_per_tick
-                total = steps + receiving + world
-                print(
-                    f"{'':>5}  CPU per tick over Zenoh (ticks {CPU_FROM}-{CPU_TO}): AGV main "
-                    f"threads {steps:.1f} ms ({steps / size:.2f} per AGV), AGV receiving "
-                    f"{receiving:.1f} ms, world {world:.1f} ms; {total:.1f} ms on "
-                    f"{os.cpu_count()} cores: at most {1e3 * os.cpu_count() / total:.1f} ticks/s"
-                )
-            for agvs, target in ((50, 20), (100, 10)):
-                if size == agvs:
-                    verdicts.append(
-                        (f"{agvs} AGVs over Zenoh >= {target} ticks/s", bus.ticks_per_s >= target,
-                         bus.ticks_per_s, f"; the bus floor {floor:.1f}")
-                    )  # fmt: skip
-            if size == 50:
-                verdicts.append(("start-up of 50 AGVs < 5 s", bus.start_up < 5, bus.start_up, ""))
-    for what, ok, value, note in verdicts:
-        print(f"{'PASS' if ok else 'MISS'}  {what} ({value:.2f}{note})")
+        for map_name in maps:
+            for size in (int(s) for s in args.sizes.split(",")):
+                path = Path(folder) / f"bench-{map_name}-{size}.toml"
+                path.write_text(scenario_text(map_name, size, args.sim_time))
+                scenario = load_scenario(path)
+                local = Outcome(problem="skipped (--zenoh-only)")
+                if not args.zenoh_only:
+                    local = measured(
+                        partial(run_in_process, scenario),
+                        Clock(False, last_tick_before_the_limit(scenario)),
+                    )
+                floor, floor_problem = floor_rate(scenario)
+                bus = zenoh_median(scenario, path, args.runs)
+                report(map_name, size, local, bus, floor, floor_problem, verdicts)
+    for ok, what, value in verdicts:
+        print(f"{'PASS' if ok else 'MISS'}  {what} ({fmt(value, 0, 2).strip()})")
+    print(f"fleet_bench took {time.monotonic() - started:.0f} s")
 
 
 if __name__ == "__main__":

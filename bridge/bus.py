@@ -1,6 +1,7 @@
 """Typed publish/subscribe on a run's keys, with a codec that never crashes a node.
 
-Payloads are compact JSON of ``bridge.messages`` types. Every payload is validated
+Payloads are compact JSON of ``bridge.messages`` types, the tick's MessagePack
+(``bridge.wire``). Every payload is validated
 before anyone sees it: its size (``MAX_PAYLOAD_BYTES``), JSON nesting (Python's parser
 stops at its recursion limit), every field's type, finite numbers, list lengths, and
 that a message on ``agv/<name>/...`` names that AGV (in C by ``bridge.struct_decoder``,
@@ -19,13 +20,15 @@ import queue
 from collections import Counter
 from dataclasses import dataclass
 
+import msgspec
 import zenoh
 
 from bridge import keys
 from bridge.log import say
-from bridge.messages import MessageError, encode, from_dict
+from bridge.messages import MessageError, from_dict
 from bridge.session import MAX_MESSAGE_BYTES
 from bridge.struct_decoder import decode_valid
+from bridge.wire import is_binary, to_wire
 
 MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
 # keys counted one by one; past that, under OTHER_KEYS (a forger picks the keys)
@@ -40,18 +43,28 @@ def decode(key: str, payload: bytes):
         raise MessageError("no message type for this key")
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
-    msg = decode_valid(cls, payload)
+    binary = is_binary(key)
+    msg = decode_valid(cls, payload, binary)
     if msg is None:  # refused by the fast path: the reference decoder decides, and says why
-        msg = _reference_decode(cls, payload)
+        msg = _reference_decode(cls, payload, binary)
     owner = keys.agv_name(key)
     if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
     return msg
 
 
-def _reference_decode(cls, payload: bytes):
-    """``cls`` from ``payload`` by the json module and ``from_dict``: slower than the fast
-    path, and the one that names what is wrong."""
+def _reference_decode(cls, payload: bytes, binary: bool = False):
+    """``cls`` from ``payload`` by the json module (``binary``: msgspec's MessagePack
+    reader, untyped) and ``from_dict``: slower than the fast path, and the one that names
+    what is wrong."""
+    if binary:
+        try:
+            data = msgspec.msgpack.decode(payload)
+        except msgspec.DecodeError as err:
+            raise MessageError(f"not MessagePack: {err}"[:200]) from None
+        except RecursionError:
+            raise MessageError("MessagePack nested too deeply") from None
+        return from_dict(cls, data)
     try:
         data = json.loads(payload)
     except (ValueError, UnicodeDecodeError) as err:
@@ -85,7 +98,7 @@ class Bus:
         return str(key_expr)[len(self.prefix) + 1 :]
 
     def publish(self, key: str, msg) -> None:
-        self.publish_payload(key, encode(msg))
+        self.publish_payload(key, to_wire(key, msg))
 
     def publish_payload(self, key: str, payload: bytes) -> None:
         pub = self._publishers.get(key)
@@ -98,7 +111,7 @@ class Bus:
 
     def subscribe(self, key_expr: str) -> queue.SimpleQueue:
         """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
-        (with its payload as it came, which the recorder stores)."""
+        (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``)."""
         q: queue.SimpleQueue = queue.SimpleQueue()
 
         def on_sample(sample: zenoh.Sample) -> None:

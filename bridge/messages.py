@@ -195,7 +195,7 @@ def encode(msg) -> bytes:
     return _ENCODER.encode(msg)
 
 
-def _plain_number(value):
+def plain_number(value):
     """numpy's float64 (some planner values are) as the float it equals; msgspec calls
     this only for the types it does not know, and names one it cannot encode."""
     if isinstance(value, float):
@@ -203,7 +203,7 @@ def _plain_number(value):
     raise NotImplementedError
 
 
-_ENCODER = msgspec.json.Encoder(enc_hook=_plain_number)
+_ENCODER = msgspec.json.Encoder(enc_hook=plain_number)
 
 
 def to_dict(msg) -> dict:

@@ -3,7 +3,9 @@
 Isolation is by construction: the world's router listens on a fresh per-run
 endpoint (a Unix socket in a new temporary folder by default, or a free
 ``tcp/127.0.0.1`` port), multicast and gossip scouting are off, shared memory
-is off (it leaves files in /dev/shm when a process is killed) and every key
+is off unless ``AGV_FLEET_SHARED_MEMORY=1`` is in the environment (it leaves files in
+/dev/shm when a process is killed; on, Zenoh puts every message above 3 KB, a tick,
+into shared memory once instead of copying it to each AGV's socket) and every key
 lives under a per-run prefix. A short lease (1 s) makes a dead or hung peer
 visible to liveliness subscribers within about a second. Messages larger
 than ``MAX_MESSAGE_BYTES`` are dropped by Zenoh itself, before any buffer
@@ -28,6 +30,7 @@ LEASE_MS = 1000
 # bytes); a larger one is dropped when it arrives: 50 MB messages cost memory in every node
 MAX_MESSAGE_BYTES = 16 * 1024 * 1024
 CONNECT_ATTEMPT_MS = 500
+SHARED_MEMORY_ENV = "AGV_FLEET_SHARED_MEMORY"  # "1": Zenoh's shared memory on (inherited)
 CONNECT_TIMEOUT_S = 30.0  # a client gives up when no router answered for this long
 # A client (one AGV) needs one thread per Zenoh runtime: with the default pools,
 # 50 AGV processes on 2 cores spend a third of their CPU on idle runtime threads.
@@ -111,7 +114,7 @@ def make_config(
     _set(config, "connect/endpoints", list(connect))
     _set(config, "scouting/multicast/enabled", False)
     _set(config, "scouting/gossip/enabled", False)
-    _set(config, "transport/shared_memory/enabled", False)
+    _set(config, "transport/shared_memory/enabled", shared_memory())
     _set(config, "transport/link/tx/lease", LEASE_MS)
     _set(config, "transport/link/rx/max_message_size", MAX_MESSAGE_BYTES)
     if login:
@@ -123,6 +126,11 @@ def make_config(
     if mode == "client":
         _set(config, "connect/timeout_ms", CONNECT_ATTEMPT_MS)
     return config
+
+
+def shared_memory() -> bool:
+    """Whether this process and the ones it starts use Zenoh's shared memory."""
+    return os.environ.get(SHARED_MEMORY_ENV) == "1"
 
 
 def has_authentication(config_file: str | None) -> bool:

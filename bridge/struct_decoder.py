@@ -33,9 +33,10 @@ _FLOAT = Annotated[float, msgspec.Meta(gt=-float(FLOAT_INT_LIMIT), lt=float(FLOA
 _COUNT = Annotated[int, msgspec.Meta(ge=0, le=MAX_COUNT)]
 
 
-def decode_valid(cls, payload: bytes):
-    """The ``cls`` message of a JSON ``payload`` if msgspec's checks pass, else None."""
-    decode, to_message = _decoder(cls)
+def decode_valid(cls, payload: bytes, binary: bool = False):
+    """The ``cls`` message of a JSON (``binary``: MessagePack) ``payload`` if msgspec's
+    checks pass, else None."""
+    decode, to_message = _decoder(cls, binary)
     try:
         return to_message(decode(payload))
     except msgspec.MsgspecError:
@@ -43,8 +44,9 @@ def decode_valid(cls, payload: bytes):
 
 
 @functools.cache
-def _decoder(cls):
-    return msgspec.json.Decoder(_struct(cls)).decode, _copier(cls)
+def _decoder(cls, binary: bool):
+    kind = msgspec.msgpack.Decoder if binary else msgspec.json.Decoder
+    return kind(_struct(cls)).decode, _copier(cls)
 
 
 def _type(hint, choices=None):

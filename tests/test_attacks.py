@@ -24,8 +24,8 @@ from pathlib import Path
 import pytest
 
 from bridge import keys
-from bridge.bus import Bus, encode
-from bridge.messages import AgvCommand, AgvState, Tick, to_dict
+from bridge.bus import Bus
+from bridge.messages import AgvCommand, AgvState, Tick, encode, to_dict
 from bridge.session import (
     BusError,
     Login,
@@ -42,6 +42,7 @@ from bridge.trust import (
     read_credentials,
     write_run_credentials,
 )
+from bridge.wire import to_wire
 from fleet.runtime.inprocess import run_in_process
 from fleet.runtime.world_server import WorldServer
 from fleet.scenario import load_scenario
@@ -192,7 +193,7 @@ def test_another_agvs_credentials_cannot_forge_agv1s_state_tick_or_token(undistu
             s.liveliness().declare_token(run.bus.full(keys.alive_agv("left")))
             for k in range(ATTACK_AT_TICK, ATTACK_AT_TICK + 40):
                 run.put(s, keys.agv_command("left"), encode(forged_command("left", k)))
-                run.put(s, keys.WORLD_TICK, encode(Tick(k, k * 0.1, [])))
+                run.put(s, keys.WORLD_TICK, to_wire(keys.WORLD_TICK, Tick(k, k * 0.1, [])))
                 time.sleep(0.005)
 
     with fleet_on_bus(guarded=True) as run:
@@ -242,13 +243,14 @@ def test_a_second_process_with_a_running_agvs_name_is_refused(undisturbed):
 # --- an open run: validation alone ---------------------------------------------------
 
 NESTED = b"[" * 100_000 + b"]" * 100_000
+NESTED_MSGPACK = b"\x91" * 100_000 + b"\xc0"  # the tick is MessagePack on the bus
 FOREIGN = json.dumps({"tick": "soon", "agvs": {"left": 1}, "hello": "world"}).encode()
 
 
 ATTACKS = {
     # a well-formed tick for the next ticks, without 'left': it killed every AGV
     "forged tick lacking an AGV": lambda run: [
-        (keys.WORLD_TICK, encode(Tick(k, k * 0.1, [forged_arrival("right", k)])))
+        (keys.WORLD_TICK, to_wire(keys.WORLD_TICK, Tick(k, k * 0.1, [forged_arrival("right", k)])))
         for k in range(ATTACK_AT_TICK, ATTACK_AT_TICK + 30)
     ],
     "NaN command": lambda run: [
@@ -266,6 +268,10 @@ ATTACKS = {
     "100000-deep nested JSON": lambda run: [
         (keys.WORLD_TICK, NESTED),
         (keys.agv_command("left"), NESTED),
+    ],
+    "100000-deep nested MessagePack": lambda run: [
+        (keys.WORLD_TICK, NESTED_MSGPACK),
+        (keys.agv_command("left"), NESTED_MSGPACK),
     ],
     "foreign JSON on our topics": lambda run: [
         (keys.WORLD_TICK, FOREIGN),

@@ -16,8 +16,7 @@ import pytest
 from mcap.reader import make_reader
 
 from bridge import keys
-from bridge.bus import encode
-from bridge.messages import AgvState, json_schema
+from bridge.messages import AgvState, encode, json_schema
 from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario, parse_scenario, with_traffic
 from recordings.reader import RecordingError, open_recording

@@ -8,13 +8,14 @@ import json
 
 import pytest
 
-from bridge.bus import _reference_decode, decode, encode
+from bridge.bus import _reference_decode, decode
 from bridge.messages import (
     FLOAT_INT_LIMIT,
     MAX_COUNT,
     AgvCommand,
     MessageError,
     Tick,
+    encode,
     to_dict,
 )
 from bridge.struct_decoder import decode_valid

@@ -18,6 +18,7 @@ import queue
 
 from bridge import keys
 from bridge.bus import Bus
+from bridge.wire import json_payload
 from fleet.runtime.world_watch import WorldWatch
 from recordings.writer import RecordingWriter
 
@@ -59,7 +60,8 @@ def serve_recorder(
             last[received.key] = received.payload
             tick = getattr(received.msg, "tick", 0)
             at = max(at, tick * dt)
-            writer.write_payload(received.key, received.payload, tick * dt_ns)
+            payload = json_payload(received.key, received.payload)  # recordings are JSON
+            writer.write_payload(received.key, payload, tick * dt_ns)
             count += 1
             if received.key == keys.WORLD_RESULT:  # the run's last message
                 result = _result(received.msg.summary)

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
+from fleet.runtime.agv_gaps import agv_gaps
 from fleet.runtime.reservations import Reservations
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
@@ -314,10 +315,9 @@ class World:
             clearance = np.minimum(clearance, gaps)
             contacts.update(frozenset((names[i], ob.name)) for i in np.flatnonzero(gaps <= 0))
         if len(names) > 1:
-            gaps = np.hypot(xs[:, None] - xs, ys[:, None] - ys) - radii[:, None] - radii
-            np.fill_diagonal(gaps, np.inf)
-            clearance = np.minimum(clearance, gaps.min(axis=1))
-            for i, j in zip(*np.nonzero(np.triu(gaps <= 0)), strict=True):
+            least, touching = agv_gaps(xs, ys, radii)
+            clearance = np.minimum(clearance, least)
+            for i, j in touching:
                 contacts.add(frozenset((names[i], names[j])))
         for name, c in zip(names, clearance, strict=True):
             record = self.records[name]
