@@ -17,9 +17,13 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
-# the world's end-of-run summary (its loop count), not a control cycle's: the world
-# process loads it once
-WORLD_ONLY = {"planner.core.path_metrics._crossings"}
+# the world's kernels, not a control cycle's: its end-of-run summary (the loop count) and
+# its AGV-to-AGV contact check; the world process loads them once
+WORLD_ONLY = {
+    "planner.core.path_metrics._crossings",
+    "fleet.runtime.agv_gaps.agv_gaps",
+    "fleet.runtime.world.agv_gaps",
+}
 
 PROBE = textwrap.dedent(
     """
