@@ -14,7 +14,10 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from fleet.builtin import builtin_scenarios
+from fleet.missions.format import AGV_TASK_KEYS, parse_missions
+from fleet.missions.spec import Missions
 from fleet.moving_obstacle import MODES, MovingObstacle
+from fleet.placement import check_room
 from fleet.toml_schema import (
     ScenarioError,
     as_cell,
@@ -31,8 +34,7 @@ from planner.core.limits import read_input_file
 from planner.core.motion import CONTROL_PERIOD
 from planner.core.profiles import DEFAULT, PROFILES
 from planner.local.config import DwaConfig
-from planner.maps.clearance import ClearanceError, clearance_for, keeps
-from planner.maps.costmap import point_clearance
+from planner.maps.clearance import ClearanceError, clearance_for
 from planner.maps.grid import GridMap
 from planner.maps.loaders import load_map
 from planner.maps.random_map import random_map
@@ -42,7 +44,7 @@ from planner.nav.fusion import VARIANTS, FusionConfig
 
 TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
-    "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic",
+    "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic", "stations", "tasks",
 )  # fmt: skip
 ZONES, RESERVATIONS = "zones", "reservations"
 TRAFFIC_MODES = (ZONES, RESERVATIONS)
@@ -77,7 +79,7 @@ VEHICLE_KEYS = {
     "max_omega": ("max_omega", math.pi / 180),  # deg/s
     "max_alpha": ("max_alpha", math.pi / 180),  # deg/s²
 }
-AGV_KEYS = ("name", "start", "goal", "heading", "profile", "planner", *VEHICLE_KEYS)
+AGV_KEYS = ("name", "start", "goal", "heading", "profile", "planner", *VEHICLE_KEYS, *AGV_TASK_KEYS)
 TEMPORARY_KEYS = ("type", "name", "cells", "appear_at")
 MOVING_KEYS = ("type", "name", "radius", "waypoints", "speed", "mode", "start_at")
 
@@ -118,6 +120,7 @@ class Scenario:
     source: str
     path: str
     traffic: str = ZONES  # TRAFFIC_MODES
+    missions: Missions | None = None  # a shift of transport tasks (fleet.missions)
 
     def __post_init__(self) -> None:
         # dt is the run's one control period: the world steps by it, each AGV's DWA plans
@@ -181,7 +184,10 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     vehicle_defaults = get_table(doc, "agv_defaults", "")
     check_keys(vehicle_defaults, VEHICLE_KEYS, "agv_defaults")
     _parse_config(planner_defaults, "planner", vehicle_defaults, "agv_defaults", dt, profile)
-    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile)
+    shift = "tasks" in doc
+    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile, shift)
+    missions = parse_missions(doc, grid, agvs)
+    shift_end = missions.shift if missions else 300.0  # time_limit's default
     temporary, moving = _parse_obstacles(get_list(doc, "obstacles", "", default=[]), grid)
     traffic = get_table(doc, "traffic", "")
     check_keys(traffic, TRAFFIC_KEYS, "traffic")
@@ -190,7 +196,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         description=get_str(doc, "description", "", default=""),
         dt=dt,
         time_limit=get_number(
-            doc, "time_limit", "", default=300.0, positive=True, maximum=MAX_TIME_LIMIT
+            doc, "time_limit", "", default=shift_end, positive=True, maximum=MAX_TIME_LIMIT
         ),
         sensing_radius=get_number(doc, "sensing_radius", "", default=5.0, minimum=0.0),
         grid=grid,
@@ -200,6 +206,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         source=text,
         path=str(path) if path else "",
         traffic=get_str(traffic, "mode", "traffic", default=ZONES, choices=TRAFFIC_MODES),
+        missions=missions,
     )
 
 
@@ -289,8 +296,9 @@ def _parse_config(
 
 
 def _parse_agvs(
-    doc, grid, dt, planner_defaults, vehicle_defaults, profile=DEFAULT
+    doc, grid, dt, planner_defaults, vehicle_defaults, profile=DEFAULT, shift=False
 ) -> tuple[AgvSpec, ...]:
+    """The [[agvs]]; in a shift (``shift``) an AGV may omit its goal (its start then)."""
     raw = get_list(doc, "agvs", "")
     if not raw:
         raise ScenarioError("a scenario needs at least one [[agvs]] entry")
@@ -319,19 +327,12 @@ def _parse_agvs(
         own_profile = get_str(entry, "profile", where, default=profile, choices=PROFILES)
         config = _parse_config(planner, f"{where}.planner", vehicle, where, dt, own_profile)
         start = as_point(get_list(entry, "start", where), f"{where}.start")
-        goal = as_point(get_list(entry, "goal", where), f"{where}.goal")
+        if "goal" not in entry and shift:  # an AGV of a shift: its goals are its tasks'
+            goal = start
+        else:
+            goal = as_point(get_list(entry, "goal", where), f"{where}.goal")
         for what, point in (("start", start), ("goal", goal)):
-            try:
-                grid.free_cell_of(point, what)
-            except MapError as err:
-                raise ScenarioError(f"{who}: {err}") from None
-            room = point_clearance(grid, point, config.dwa.radius)
-            if not keeps(room, config.dwa.radius):
-                shown = math.floor(room * 1e4 + 1e-6) / 1e4  # not rounded up to the radius
-                raise ScenarioError(
-                    f"{who}: {what} ({point[0]:g}, {point[1]:g}) is {shown:.4f} m from an obstacle "
-                    f"or the map's edge, less than the AGV radius {config.dwa.radius:g} m"
-                )
+            check_room(grid, point, config.dwa.radius, who, what)
         heading = get_number(entry, "heading", where, default=0.0)
         agvs.append(AgvSpec(name, start, goal, heading, config))
     return tuple(agvs)

@@ -20,7 +20,18 @@ from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
 from fleet.scenario import RESERVATIONS, Scenario
 from planner.core.motion import moving_discs
-from planner.core.status import DRIVING, FAILED, FINISHED, INITIAL, REPLAN, TRAFFIC, WAITING
+from planner.core.status import (
+    ARRIVED,
+    DRIVING,
+    FAILED,
+    FINISHED,
+    INITIAL,
+    LOADING,
+    PARKED,
+    REPLAN,
+    TRAFFIC,
+    WAITING,
+)
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.nav.fusion import FusionController
@@ -30,6 +41,8 @@ from planner.route.global_planner import PlanResult
 from planner.traffic.follow import follow_point
 from planner.traffic.guard import TrafficGuard
 from planner.traffic.schedule import Reservation
+
+HELD = (LOADING, PARKED)  # statuses of an AGV the world holds at its goal (a shift)
 
 
 @dataclass
@@ -57,12 +70,18 @@ class AgvNode:
         self.scenario = scenario
         self.spec = scenario.agv(name)
         self.name = name
-        self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
-        self.guard = traffic_guard(scenario, self.controller)
-        self._parked: frozenset[str] = frozenset()
         self._stopped_at: dict[str, float] = {}  # sim time each other AGV stopped for good
-        self._started = False
         self._index = 0  # where this AGV's state was in the last tick's list
+        self._drive_to(self.spec.goal)
+
+    def _drive_to(self, goal) -> None:
+        """A controller for ``goal``: at the start, and in a shift for each new goal the
+        world gives (it plans from where the AGV stands at the next tick)."""
+        self.goal = tuple(goal)
+        self.controller = FusionController(self.scenario.grid, self.goal, self.spec.config)
+        self.guard = traffic_guard(self.scenario, self.controller)
+        self._parked: frozenset[str] = frozenset()  # told again to the new controller
+        self._started = False
 
     def warm_up(self) -> None:
         """Load (or compile) every numba kernel this node uses, before the run starts
@@ -80,11 +99,18 @@ class AgvNode:
         start_heading = None
         if me.status == FAILED:  # the world gave up on this AGV: stand still
             return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), FAILED))
+        if tick.assignments:
+            goal = self._assigned_goal(tick)
+            if me.status in HELD and goal == self.goal:
+                # held at its goal by the shift (a dwell, or idle at home): it stands there
+                return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), ARRIVED))
+            if goal != self.goal:
+                self._drive_to(goal)
         if not self._started:
             self._started = True
             pose, plan = self.controller.start(pose)
             plan_msg = self._plan_msg(tick, plan, INITIAL)
-            if pose[2] != me.theta:
+            if pose[2] != me.theta and tick.tick == 0:
                 start_heading = float(pose[2])
         self._sense(tick, pose)
         self._park(tick)
@@ -131,6 +157,11 @@ class AgvNode:
                 self.name, tick.tick, step.trajectory[:, :2].round(4).tolist()
             )
         return NodeOutput(command, plan_msg, trajectory)
+
+    def _assigned_goal(self, tick: Tick) -> tuple[float, float]:
+        """This AGV's goal in a shift's ``tick`` (its own goal if the tick has none)."""
+        mine = next((a for a in tick.assignments if a.name == self.name), None)
+        return self.goal if mine is None else tuple(mine.goal)
 
     def _reservation(self, tick: Tick) -> Reservation | None:
         """This AGV's reservation in ``tick`` (traffic mode "reservations"), else None."""

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
+from fleet.runtime.missions import MissionControl
 from fleet.runtime.reservations import Reservations
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
@@ -39,6 +40,7 @@ from planner.traffic.guard import ROUTE_POINTS
 from planner.traffic.zones import Intent
 
 INTERRUPTED = "interrupted"  # the end reason of a run ended by Ctrl-C or SIGTERM
+SHIFT_OVER = "shift over"  # the end reason of a shift at its end (or its time limit)
 
 
 @dataclass
@@ -91,10 +93,12 @@ class World:
         self.ended = False
         self.end_reason = ""
         self.reservations = Reservations.of(scenario)  # None: the zone rule
+        self.missions = MissionControl(scenario) if scenario.missions else None
 
     # --- the clock ----------------------------------------------------------------
     def first_tick(self) -> Tick:
         self._check_contacts()
+        self._dispatch()
         self._reserve()
         return self._make_tick()
 
@@ -117,14 +121,35 @@ class World:
                 self._apply(name, command)
         self._refresh_temporary()
         self._check_contacts()
+        self._dispatch()
         if not self._running():
             self._end(self._done_reason())
         elif self.time >= self.scenario.time_limit - 1e-9:
-            self._end("time limit")
+            self._end(SHIFT_OVER if self.missions else "time limit")
         if self.ended:
             return None
         self._reserve()
         return self._make_tick()
+
+    def _dispatch(self) -> None:
+        """A shift: the dispatcher's decisions for this tick, its new goals to the traffic
+        schedule, and the status of every AGV it holds at a goal (``fleet.runtime.missions``)."""
+        if self.missions is None:
+            return
+        live = self.live_agvs()
+        positions = {n: (self.states[n].x, self.states[n].y) for n in live}
+        events, goals = self.missions.update(positions, self.tick, self.time)
+        self.events.extend(events)
+        if self.reservations is not None:
+            for name, goal in goals.items():
+                self.reservations.set_goal(name, goal)
+        for name in live:
+            state = self.states[name]
+            state.status = self.missions.status(name, state.status)
+
+    def _goal(self, name: str):
+        """Where AGV ``name`` is going: its goal, or in a shift its current task's."""
+        return self.missions.goal(name) if self.missions else self.scenario.agv(name).goal
 
     def _reserve(self) -> None:
         """Traffic mode "reservations": the schedule's step for this tick (its events too)."""
@@ -148,8 +173,9 @@ class World:
                 self._refuse(name, "a start heading after tick 0 or outside the paper profile")
         status = command.status
         requested = (command.vx, command.vy, command.omega)
-        if status == ARRIVED and math.dist(pose[:2], spec.goal) > spec.config.goal_tolerance + 1e-9:
-            far = math.dist(pose[:2], spec.goal)
+        goal = self._goal(name)
+        if status == ARRIVED and math.dist(pose[:2], goal) > spec.config.goal_tolerance + 1e-9:
+            far = math.dist(pose[:2], goal)
             self._refuse(name, f"arrival claimed {far:.2f} m from the goal")
             status = DRIVING
         if status in FINISHED:
@@ -178,7 +204,9 @@ class World:
             name, self.tick, x, y, theta, *velocity, old.radius, status,
             command.target, command.plan_time_ms, command.failure if status == FAILED else "",
         )  # fmt: skip
-        if status in FINISHED and record.status not in FINISHED:
+        if status == ARRIVED and self.missions:
+            self.missions.at_goal.add(name)  # a shift goes on: the dispatcher answers
+        elif status in FINISHED and record.status not in FINISHED:
             self._finish(name, status, command.failure or status)
 
     def _take_intent(self, name: str, intent: Intent | None, status: str) -> None:
@@ -242,6 +270,8 @@ class World:
 
     # --- internals ----------------------------------------------------------------
     def _finish(self, name: str, status: str, why: str) -> None:
+        if self.missions is not None:
+            self.missions.retire(name)  # only a failure ends an AGV's shift
         if self.reservations is not None:
             state = self.states[name]
             self.reservations.finish(name, status, (state.x, state.y))
@@ -267,6 +297,7 @@ class World:
             temporary=[list(c) for c in self._temporary_shown],
             intents=self._claims(),
             reservations=self.reservations.current if self.reservations is not None else [],
+            assignments=self.missions.assignments() if self.missions else [],
         )
 
     def _claims(self) -> list[Intent]:
