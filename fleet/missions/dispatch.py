@@ -65,6 +65,7 @@ class TaskEvent:
     time: float
     kind: str  # planner.core.status.TASK_EVENTS
     task: Task
+    agv: str = ""  # the AGV serving the task then ('' for a request not yet taken)
 
     @property
     def detail(self) -> str:
@@ -122,7 +123,7 @@ class Dispatcher:
             task = Task(self.pending.pop(0))
             self.tasks.append(task)
             self.queue.append(task)
-            events.append(TaskEvent(now, REQUESTED, task))
+            events.append(TaskEvent(now, REQUESTED, task, task.agv))
         for agv in self.agvs.values():
             arrived = agv.name in at_goal
             while self._advance(agv, arrived, events):
@@ -149,7 +150,7 @@ class Dispatcher:
             task = agv.task
             if task.picked_up is None:
                 task.picked_up = now
-                events.append(TaskEvent(now, PICKED_UP, task))
+                events.append(TaskEvent(now, PICKED_UP, task, task.agv))
             if self.holder.get(task.request.target, agv.name) != agv.name:
                 return False  # the drop-off is held: wait here, holding the pick-up
             del self.holder[agv.station]
@@ -158,7 +159,7 @@ class Dispatcher:
         elif agv.phase == AT_DROP_OFF and now >= agv.dwell_until - EPS:
             task = agv.task
             task.delivered = now
-            events.append(TaskEvent(now, DELIVERED, task))
+            events.append(TaskEvent(now, DELIVERED, task, task.agv))
             del self.holder[agv.station]
             agv.task = None
             if agv.own is not None:
@@ -183,7 +184,7 @@ class Dispatcher:
         self._numbers += 1
         task = Task(Request(self._numbers, self.now, source, target))
         self.tasks.append(task)
-        events.append(TaskEvent(self.now, REQUESTED, task))
+        events.append(TaskEvent(self.now, REQUESTED, task, task.agv))
         self._give(agv, task, events)
         return True
 
@@ -205,7 +206,7 @@ class Dispatcher:
     def _give(self, agv: AgvWork, task: Task, events: list[TaskEvent]) -> None:
         task.agv, task.assigned = agv.name, self.now
         agv.task = task
-        events.append(TaskEvent(self.now, ASSIGNED, task))
+        events.append(TaskEvent(self.now, ASSIGNED, task, task.agv))
         if task.request.source in self.holder:  # only for its own list: home till free
             self._go_home(agv)
         else:

@@ -42,7 +42,7 @@ class MissionControl:
         self.at_goal = set()
         self.log.extend(events)
         changed = {n: a.goal for n, a in self.dispatcher.agvs.items() if a.goal != before[n]}
-        out = [Event(tick, now, e.kind, [e.task.agv] * bool(e.task.agv), e.detail) for e in events]
+        out = [Event(tick, now, e.kind, [e.agv] * bool(e.agv), e.detail) for e in events]
         return out, changed
 
     def status(self, name: str, reported: str) -> str:

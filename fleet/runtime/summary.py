@@ -169,7 +169,7 @@ def _tasks(world: World) -> dict | None:
     if world.missions is None:
         return None
     events = [
-        {"kind": e.kind, "time": e.time, "agvs": [e.task.agv], "detail": e.detail}
+        {"kind": e.kind, "time": e.time, "agvs": [e.agv], "detail": e.detail}
         for e in world.missions.log
     ]
     return shift_stats(events, world.time).to_json()
