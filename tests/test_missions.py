@@ -255,3 +255,21 @@ def test_the_summary_json_has_the_tasks_block():
     block = json.loads(json.dumps(summary.to_json()))["tasks"]
     assert set(block) == {"requested", "assigned", "delivered", "throughput_per_hour",
                           "task_time_mean", "task_time_p95", "queue_time_mean"}  # fmt: skip
+
+
+def test_rerun_draws_the_stations_and_each_agvs_current_task(tmp_path):
+    from recordings.rerun_view import save_rrd
+    from tests.test_rerun import read_rrd
+
+    path, rrd = tmp_path / "two.mcap", tmp_path / "two.rrd"
+    run_recorded(parse_scenario(two_stations(shift=120.0)), path, {"mode": "in-process"})
+    save_rrd(open_recording(path), rrd)
+    entities = read_rrd(rrd)  # the .rrd as Rerun's own reader reads it
+    assert entities["/world/stations"].static >= 1
+    labels = [
+        label
+        for _, row in entities["/world/agv/agv1/task"].rows
+        for label in row.get("Points2D:labels") or []
+    ]
+    assert labels[:5] == ["task 1 to a", "task 1 at a", "task 1 to b", "task 1 at b", "task 2 to a"]
+    assert len(entities["/world/agv/agv1/task/way"].rows) > 100  # drawn while it drives

@@ -18,6 +18,7 @@ import numpy as np
 
 from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
+from fleet.runtime.world import HELD
 from fleet.scenario import RESERVATIONS, Scenario
 from planner.core.motion import moving_discs
 from planner.core.status import (
@@ -26,8 +27,6 @@ from planner.core.status import (
     FAILED,
     FINISHED,
     INITIAL,
-    LOADING,
-    PARKED,
     REPLAN,
     TRAFFIC,
     WAITING,
@@ -41,8 +40,6 @@ from planner.route.global_planner import PlanResult
 from planner.traffic.follow import follow_point
 from planner.traffic.guard import TrafficGuard
 from planner.traffic.schedule import Reservation
-
-HELD = (LOADING, PARKED)  # statuses of an AGV the world holds at its goal (a shift)
 
 
 @dataclass

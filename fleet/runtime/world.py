@@ -30,6 +30,8 @@ from planner.core.status import (
     END,
     FAILED,
     FINISHED,
+    LOADING,
+    PARKED,
     RECOVERY,
     REFUSED,
     WAITING,
@@ -40,6 +42,7 @@ from planner.traffic.guard import ROUTE_POINTS
 from planner.traffic.zones import Intent
 
 INTERRUPTED = "interrupted"  # the end reason of a run ended by Ctrl-C or SIGTERM
+HELD = (LOADING, PARKED)  # statuses of an AGV a shift holds at its goal (fleet.missions)
 SHIFT_OVER = "shift over"  # the end reason of a shift at its end (or its time limit)
 
 
@@ -154,7 +157,11 @@ class World:
     def _reserve(self) -> None:
         """Traffic mode "reservations": the schedule's step for this tick (its events too)."""
         if self.reservations is not None:
-            running = {n: (self.states[n].x, self.states[n].y) for n in self._running()}
+            running = {
+                n: (self.states[n].x, self.states[n].y)
+                for n in self._running()
+                if self.states[n].status not in HELD  # a shift holds it at its goal node:
+            }  # frozen there in the plan, it needs no reservation (idle AGVs cost ~nothing)
             self.events.extend(self.reservations.update(running, self.tick, self.time))
 
     def _apply(self, name: str, command: AgvCommand) -> None:
