@@ -273,3 +273,42 @@ def test_rerun_draws_the_stations_and_each_agvs_current_task(tmp_path):
     ]
     assert labels[:5] == ["task 1 to a", "task 1 at a", "task 1 to b", "task 1 at b", "task 2 to a"]
     assert len(entities["/world/agv/agv1/task/way"].rows) > 100  # drawn while it drives
+
+
+def test_agvs_count_puts_the_fleet_on_the_parking_stations():
+    import tomlkit
+
+    from fleet.sweep.keys import SweepKeyError, apply
+
+    doc = tomlkit.parse(load_scenario("warehouse-shift").source)
+    apply(doc, "agvs.count", 32)
+    scenario = parse_scenario(tomlkit.dumps(doc))
+    parking = [s.position for s in scenario.missions.stations if s.group == "parking"]
+    assert [a.start for a in scenario.agvs] == parking[:32]
+    assert [a.name for a in scenario.agvs][-1] == "agv32"
+    assert scenario.agvs[0].config == load_scenario("warehouse-shift").agvs[0].config
+    with pytest.raises(SweepKeyError, match="stations of group 'parking'"):
+        apply(doc, "agvs.count", 33)
+    with pytest.raises(SweepKeyError, match="positive integer"):
+        apply(doc, "agvs.count", 0)
+
+
+def test_a_fleet_sizing_sweep_has_task_metrics_first_and_a_sizing_plot(tmp_path):
+    from recordings.sweep_plots import SIZING_PLOT, save_box_plots
+    from recordings.sweep_report import SweepEntry, stats_table, variant_stats
+
+    def entry(count, seed, rate, time):
+        tasks = {"requested": 100, "assigned": 100, "delivered": rate,
+                 "throughput_per_hour": float(rate), "task_time_mean": time,
+                 "task_time_p95": 2 * time, "queue_time_mean": 1.0}  # fmt: skip
+        run = {"scenario": "warehouse-shift", "run_time": 3600.0, "tasks": tasks}
+        return SweepEntry({"agvs.count": count}, {"tasks.generator.seed": seed}, "", False, run)
+
+    entries = [entry(n, s, min(60 * n, 180) + s, 300 / n + 60) for n in (2, 4, 8) for s in (1, 2)]
+    table = stats_table(variant_stats(entries), ["tasks.generator.seed"])
+    assert table.splitlines()[2].startswith("tasks.throughput_per_hour (1/h)")
+    assert "121.5 ±" in table  # 2 AGVs: 121 and 122 an hour
+    paths = save_box_plots(entries, tmp_path, "warehouse-shift")
+    sizing = tmp_path / SIZING_PLOT
+    assert sizing in paths
+    assert sizing.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and sizing.stat().st_size < 1_000_000
