@@ -22,7 +22,6 @@ from fleet.runtime.world import HELD
 from fleet.scenario import RESERVATIONS, Scenario
 from planner.core.motion import moving_discs
 from planner.core.status import (
-    ARRIVED,
     DRIVING,
     FAILED,
     FINISHED,
@@ -87,7 +86,8 @@ class AgvNode:
         warm_up(self.scenario.grid, spec.start, spec.goal, spec.config, self.guard)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
-        """This AGV's answer to ``tick``; None for a tick that does not list it."""
+        """This AGV's answer to ``tick``; None for a tick that does not list it, or one in
+        which a shift holds it at its goal (``HELD``)."""
         me = self._own_state(tick)
         if me is None:
             return None
@@ -96,11 +96,10 @@ class AgvNode:
         start_heading = None
         if me.status == FAILED:  # the world gave up on this AGV: stand still
             return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), FAILED))
+        if me.status in HELD:  # held at its goal by a shift (a dwell, or idle at home):
+            return None  # it stands there, and the world does not wait for its answer
         if tick.assignments:
             goal = self._assigned_goal(tick)
-            if me.status in HELD and goal == self.goal:
-                # held at its goal by the shift (a dwell, or idle at home): it stands there
-                return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), ARRIVED))
             if goal != self.goal:
                 self._drive_to(goal)
         if not self._started:

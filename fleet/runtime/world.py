@@ -110,6 +110,12 @@ class World:
         arrived AGV keeps answering, parked, so every tick has every AGV's state)."""
         return [n for n, r in self.records.items() if r.status != FAILED]
 
+    def awaited(self) -> list[str]:
+        """The live AGVs whose answer the next tick waits for: in a shift, not those it
+        holds at their goal (``HELD``): the world knows their answer, standing still, and
+        their nodes send none (idle AGVs cost no round trip on the bus)."""
+        return [n for n in self.live_agvs() if self.states[n].status not in HELD]
+
     def _running(self) -> list[str]:
         return [n for n, r in self.records.items() if r.status not in FINISHED]
 
@@ -120,6 +126,8 @@ class World:
         self.time = round(self.tick * self.scenario.dt, 9)
         for name in self.live_agvs():
             command = commands.get(name)
+            if command is None and self.states[name].status in HELD:
+                command = AgvCommand(name, self.tick, 0.0, 0.0, 0.0, ARRIVED)  # stands still
             if command is not None:
                 self._apply(name, command)
         self._refresh_temporary()
