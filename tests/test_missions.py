@@ -47,7 +47,7 @@ resolution = 1.0
 grid = \"\"\"
 ..............
 ..............
-..............
+.............#
 \"\"\"
 [agv_defaults]
 radius = 0.3
@@ -213,9 +213,17 @@ def test_the_builtin_warehouse_shift_is_a_one_hour_shift_with_node_reservations(
 
 
 BAD = {
-    "a station in a wall": (
+    "a station outside the map": (
         'name = "a"\nposition = [1.5, 1.5]', 'name = "a"\nposition = [20.5, 1.5]',
-        "station 'a'",
+        "station 'a': position (20.5, 1.5) is outside the map",
+    ),
+    "a station in a wall": (
+        'name = "b"\nposition = [11.5, 1.5]', 'name = "b"\nposition = [13.5, 0.5]',
+        "station 'b': position (13.5, 0.5) is inside an obstacle",
+    ),
+    "a station without room for the body": (
+        'name = "b"\nposition = [11.5, 1.5]', 'name = "b"\nposition = [12.9, 0.5]',
+        "station 'b': position (12.9, 0.5) is 0.1000 m from an obstacle",
     ),
     "an unknown group": ("", 'generator = { rate_per_hour = 60, from = "pik", to = "drop" }',
                          "names no station group"),
