@@ -179,10 +179,10 @@ def route_length(scenario, name: str) -> float | None:
     """Length (m) of the route AGV ``name`` planned first: its key nodes from its start to
     its goal, planned again here exactly as the AGV plans it (same map, variant, profile
     and clearance), so both run modes state it without asking the AGVs. None for DWA
-    alone (no global route) or when no path exists."""
+    alone (no global route), when no path exists, or in a shift."""
     spec = scenario.agv(name)
     algorithm = GLOBAL_ALGORITHM.get(spec.config.algorithm)
-    if algorithm is None:
+    if algorithm is None or scenario.missions is not None:  # a shift: a route per task
         return None
     try:
         plan = plan_global(
