@@ -19,6 +19,7 @@ from fleet.missions.spec import Missions
 from fleet.moving_obstacle import MODES, MovingObstacle
 from fleet.placement import check_room
 from fleet.toml_schema import (
+    MAX_TIME_LIMIT,
     ScenarioError,
     as_cell,
     as_point,
@@ -51,10 +52,9 @@ TRAFFIC_MODES = (ZONES, RESERVATIONS)
 """How AGVs share space: the zone rule (``planner.traffic.zones``: one direction holds a
 passage) or node reservations in time (``planner.traffic.schedule``: PIBT steps)."""
 TRAFFIC_KEYS = ("mode",)
-# the control period (s) and the longest run (s): at most 3.6 million ticks, and no
+# the control period (s; the longest run: toml_schema.MAX_TIME_LIMIT): no
 # run whose clock never reaches its end (a dt of 1e-9 was accepted)
 DT_RANGE = (0.01, 1.0)
-MAX_TIME_LIMIT = 36_000.0
 MAP_KEYS = ("resolution", "grid", "file", "random", "unknown")
 RANDOM_KEYS = ("width", "height", "obstacle_ratio", "seed")
 # [planner]: TOML key -> (FusionConfig or DwaConfig field, scale to internal units)

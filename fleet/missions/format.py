@@ -10,6 +10,7 @@ from __future__ import annotations
 from fleet.missions.spec import Generator, Missions, Station, TaskList
 from fleet.placement import check_room
 from fleet.toml_schema import (
+    MAX_TIME_LIMIT,
     ScenarioError,
     as_point,
     check_keys,
@@ -25,7 +26,6 @@ STATION_KEYS = ("name", "position", "dwell", "group")
 TASKS_KEYS = ("shift", "generator")
 GENERATOR_KEYS = ("rate_per_hour", "from", "to", "seed")
 AGV_TASK_KEYS = ("tasks", "repeat")
-MAX_SHIFT = 36_000.0  # s, the longest run (fleet.scenario.MAX_TIME_LIMIT)
 
 
 def parse_missions(doc: dict, grid: GridMap, agvs) -> Missions | None:
@@ -39,7 +39,7 @@ def parse_missions(doc: dict, grid: GridMap, agvs) -> Missions | None:
         return None
     table = get_table(doc, "tasks", "")
     check_keys(table, TASKS_KEYS, "tasks")
-    shift = get_number(table, "shift", "tasks", positive=True, maximum=MAX_SHIFT)
+    shift = get_number(table, "shift", "tasks", positive=True, maximum=MAX_TIME_LIMIT)
     radius = max(a.radius for a in agvs)
     stations = _stations(get_list(doc, "stations", "", default=[]), grid, radius)
     groups = sorted({s.group for s in stations if s.group})
@@ -70,7 +70,7 @@ def _stations(raw: list, grid: GridMap, radius: float) -> tuple[Station, ...]:
             raise ScenarioError(f"{where}.name {name!r} is empty or not unique")
         position = as_point(get_list(entry, "position", where), f"{where}.position")
         check_room(grid, position, radius, f"station {name!r}", "position")
-        dwell = get_number(entry, "dwell", where, default=0.0, minimum=0.0, maximum=MAX_SHIFT)
+        dwell = get_number(entry, "dwell", where, default=0.0, minimum=0.0, maximum=MAX_TIME_LIMIT)
         group = get_str(entry, "group", where, default="")
         out.append(Station(name, position, dwell, group))
     return tuple(out)
