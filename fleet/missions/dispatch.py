@@ -26,7 +26,7 @@ The rule:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Set
+from collections.abc import Mapping, Sequence, Set
 from dataclasses import dataclass
 
 from fleet.missions.requests import Request
@@ -93,11 +93,10 @@ class AgvWork:
 
 class Dispatcher:
     def __init__(
-        self, missions: Missions, homes: Mapping[str, Point], requests: list[Request] = ()
+        self, missions: Missions, homes: Mapping[str, Point], requests: Sequence[Request] = ()
     ):
         """``homes``: every AGV's start, in the fleet's order; ``requests``: the
         generator's, in time order."""
-        self.missions = missions
         own = dict(missions.lists)
         self.agvs = {
             n: AgvWork(n, tuple(h), tuple(h), tuple(h), own=own.get(n)) for n, h in homes.items()

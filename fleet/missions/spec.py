@@ -50,8 +50,5 @@ class Missions:
     generator: Generator | None = None
     lists: tuple[tuple[str, TaskList], ...] = ()  # (AGV name, its list), fleet order
 
-    def station(self, name: str) -> Station:
-        return next(s for s in self.stations if s.name == name)
-
     def group(self, group: str) -> tuple[Station, ...]:
         return tuple(s for s in self.stations if s.group == group)
