@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import msgspec
 
 from planner.core.errors import BadInputError
-from planner.core.status import DRIVING, RECOVERY_KINDS, STATUSES
+from planner.core.status import DRIVING, RECOVERY_KINDS, STATUSES, TASK_PHASES
 from planner.traffic.schedule import Reservation
 from planner.traffic.zones import PHASES, Intent
 
@@ -105,6 +105,18 @@ class ObstacleState:
 
 
 @dataclass
+class Assignment:
+    """What an AGV of a shift does (``fleet.missions``): its current goal [x, y], the
+    task it serves (0: none) and its phase; the AGV plans anew when its goal changes."""
+
+    name: str
+    goal: list[float]
+    task: int = 0
+    phase: str = TASK_PHASES[-1]
+    station: str = ""  # the station of ``goal`` ('' for home)
+
+
+@dataclass
 class Tick:
     """The world's clock: tick k at time t with every AGV and obstacle.
 
@@ -123,6 +135,9 @@ class Tick:
     intents: list[Intent] = field(default_factory=list)  # passage claims, of tick k-1
     # traffic mode "reservations": the nodes each running AGV may enter, and whom it waits for
     reservations: list[Reservation] = field(default_factory=list)
+    # a shift (fleet.missions): every AGV's goal and task; empty without one (and in
+    # recordings made before it). Not in repr: the behaviour fingerprint hashes reprs
+    assignments: list[Assignment] = field(default_factory=list, repr=False)
 
 
 @dataclass
@@ -176,6 +191,7 @@ CHOICES = {
     (AgvCommand, "status"): STATUSES,
     (AgvCommand, "recovery"): ("", *RECOVERY_KINDS),
     (Intent, "phase"): PHASES,
+    (Assignment, "phase"): TASK_PHASES,
 }
 
 MESSAGE_TYPES = (MapMsg, AgvState, ObstacleState, Tick, PlanMsg, TrajectoryMsg, Event, ResultMsg)

@@ -14,8 +14,12 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from fleet.builtin import builtin_scenarios
+from fleet.missions.format import AGV_TASK_KEYS, parse_missions
+from fleet.missions.spec import Missions
 from fleet.moving_obstacle import MODES, MovingObstacle
+from fleet.placement import check_room
 from fleet.toml_schema import (
+    MAX_TIME_LIMIT,
     ScenarioError,
     as_cell,
     as_point,
@@ -31,8 +35,7 @@ from planner.core.limits import read_input_file
 from planner.core.motion import CONTROL_PERIOD
 from planner.core.profiles import DEFAULT, PROFILES
 from planner.local.config import DwaConfig
-from planner.maps.clearance import ClearanceError, clearance_for, keeps
-from planner.maps.costmap import point_clearance
+from planner.maps.clearance import ClearanceError, clearance_for
 from planner.maps.grid import GridMap
 from planner.maps.loaders import load_map
 from planner.maps.random_map import random_map
@@ -43,7 +46,7 @@ from planner.traffic.mode_choice import suits_reservations
 
 TOP_KEYS = (
     "name", "description", "dt", "time_limit", "sensing_radius", "profile",
-    "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic",
+    "map", "planner", "agv_defaults", "agvs", "obstacles", "traffic", "stations", "tasks",
 )  # fmt: skip
 ZONES, RESERVATIONS, AUTO = "zones", "reservations", "auto"
 TRAFFIC_MODES = (AUTO, ZONES, RESERVATIONS)
@@ -51,10 +54,9 @@ TRAFFIC_MODES = (AUTO, ZONES, RESERVATIONS)
 passage), node reservations in time (``planner.traffic.schedule``: PIBT steps), or the
 one of the two that suits the map and the fleet (``planner.traffic.mode_choice``)."""
 TRAFFIC_KEYS = ("mode",)
-# the control period (s) and the longest run (s): at most 3.6 million ticks, and no
+# the control period (s; the longest run: toml_schema.MAX_TIME_LIMIT): no
 # run whose clock never reaches its end (a dt of 1e-9 was accepted)
 DT_RANGE = (0.01, 1.0)
-MAX_TIME_LIMIT = 36_000.0
 MAP_KEYS = ("resolution", "grid", "file", "random", "unknown")
 RANDOM_KEYS = ("width", "height", "obstacle_ratio", "seed")
 # [planner]: TOML key -> (FusionConfig or DwaConfig field, scale to internal units)
@@ -79,7 +81,7 @@ VEHICLE_KEYS = {
     "max_omega": ("max_omega", math.pi / 180),  # deg/s
     "max_alpha": ("max_alpha", math.pi / 180),  # deg/s²
 }
-AGV_KEYS = ("name", "start", "goal", "heading", "profile", "planner", *VEHICLE_KEYS)
+AGV_KEYS = ("name", "start", "goal", "heading", "profile", "planner", *VEHICLE_KEYS, *AGV_TASK_KEYS)
 TEMPORARY_KEYS = ("type", "name", "cells", "appear_at")
 MOVING_KEYS = ("type", "name", "radius", "waypoints", "speed", "mode", "start_at")
 
@@ -131,6 +133,8 @@ class Scenario:
         agents = [(a.name, a.start, a.goal) for a in self.agvs]
         fits = suits_reservations(self.grid, clearances, agents)
         return RESERVATIONS if fits else ZONES
+
+    missions: Missions | None = None  # a shift of transport tasks (fleet.missions)
 
     def __post_init__(self) -> None:
         # dt is the run's one control period: the world steps by it, each AGV's DWA plans
@@ -194,7 +198,10 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
     vehicle_defaults = get_table(doc, "agv_defaults", "")
     check_keys(vehicle_defaults, VEHICLE_KEYS, "agv_defaults")
     _parse_config(planner_defaults, "planner", vehicle_defaults, "agv_defaults", dt, profile)
-    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile)
+    shift = "tasks" in doc
+    agvs = _parse_agvs(doc, grid, dt, planner_defaults, vehicle_defaults, profile, shift)
+    missions = parse_missions(doc, grid, agvs)
+    shift_end = missions.shift if missions else 300.0  # time_limit's default
     temporary, moving = _parse_obstacles(get_list(doc, "obstacles", "", default=[]), grid)
     traffic = get_table(doc, "traffic", "")
     check_keys(traffic, TRAFFIC_KEYS, "traffic")
@@ -203,7 +210,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         description=get_str(doc, "description", "", default=""),
         dt=dt,
         time_limit=get_number(
-            doc, "time_limit", "", default=300.0, positive=True, maximum=MAX_TIME_LIMIT
+            doc, "time_limit", "", default=shift_end, positive=True, maximum=MAX_TIME_LIMIT
         ),
         sensing_radius=get_number(doc, "sensing_radius", "", default=5.0, minimum=0.0),
         grid=grid,
@@ -213,6 +220,7 @@ def parse_scenario(text: str, path: Path | None = None) -> Scenario:
         source=text,
         path=str(path) if path else "",
         traffic=get_str(traffic, "mode", "traffic", default=AUTO, choices=TRAFFIC_MODES),
+        missions=missions,
     )
 
 
@@ -302,8 +310,9 @@ def _parse_config(
 
 
 def _parse_agvs(
-    doc, grid, dt, planner_defaults, vehicle_defaults, profile=DEFAULT
+    doc, grid, dt, planner_defaults, vehicle_defaults, profile=DEFAULT, shift=False
 ) -> tuple[AgvSpec, ...]:
+    """The [[agvs]]; in a shift (``shift``) an AGV may omit its goal (its start then)."""
     raw = get_list(doc, "agvs", "")
     if not raw:
         raise ScenarioError("a scenario needs at least one [[agvs]] entry")
@@ -332,19 +341,12 @@ def _parse_agvs(
         own_profile = get_str(entry, "profile", where, default=profile, choices=PROFILES)
         config = _parse_config(planner, f"{where}.planner", vehicle, where, dt, own_profile)
         start = as_point(get_list(entry, "start", where), f"{where}.start")
-        goal = as_point(get_list(entry, "goal", where), f"{where}.goal")
+        if "goal" not in entry and shift:  # an AGV of a shift: its goals are its tasks'
+            goal = start
+        else:
+            goal = as_point(get_list(entry, "goal", where), f"{where}.goal")
         for what, point in (("start", start), ("goal", goal)):
-            try:
-                grid.free_cell_of(point, what)
-            except MapError as err:
-                raise ScenarioError(f"{who}: {err}") from None
-            room = point_clearance(grid, point, config.dwa.radius)
-            if not keeps(room, config.dwa.radius):
-                shown = math.floor(room * 1e4 + 1e-6) / 1e4  # not rounded up to the radius
-                raise ScenarioError(
-                    f"{who}: {what} ({point[0]:g}, {point[1]:g}) is {shown:.4f} m from an obstacle "
-                    f"or the map's edge, less than the AGV radius {config.dwa.radius:g} m"
-                )
+            check_room(grid, point, config.dwa.radius, who, what)
         heading = get_number(entry, "heading", where, default=0.0)
         agvs.append(AgvSpec(name, start, goal, heading, config))
     return tuple(agvs)

@@ -12,6 +12,10 @@ from collections.abc import Iterable
 
 from planner.core.errors import BadInputError
 
+MAX_TIME_LIMIT = 36_000.0
+"""s: the longest run a scenario may ask for (time_limit, a shift): at most 3.6 million
+ticks."""
+
 
 class ScenarioError(BadInputError, ValueError):
     """A scenario file that cannot be used; the message names the key or AGV."""

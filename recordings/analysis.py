@@ -48,6 +48,7 @@ from planner.traffic.schedule import RESERVED, WAITS_FOR
 from planner.traffic.zones import DECISIONS, WAIT
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
+from recordings.task_stats import is_task_event, shift_stats
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,10 @@ class AgvAnalysis:
     waits: int = 0  # times it was held
     self_crossings: int = 0  # its loops: times its driven path crossed itself
     recoveries: int = 0  # recovery behaviours it started (planner/recovery.py)
+    # a shift (recordings.task_stats); None in a run without tasks
+    deliveries: int | None = None
+    utilisation: float | None = None  # share of the shift it had a task
+    distance_per_task: float | None = None  # m driven per delivery
 
 
 @dataclass(frozen=True)
@@ -111,6 +116,7 @@ class RunAnalysis:
     reservation_waits: int = 0  # "waits-for" events
     self_crossings: int = 0  # summed over AGVs
     recoveries: int = 0  # summed over AGVs
+    tasks: dict | None = None  # a shift's throughput (recordings.task_stats), else None
 
     @property
     def label(self) -> str:
@@ -164,6 +170,10 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         agvs.append(replace(agv, waits=waits[name], recoveries=recoveries[name]))
         cycles.append(plan_times)
     plan_times = np.concatenate(cycles) if cycles else np.zeros(0)
+    run_time = float(series.time[-1]) if len(series.time) else 0.0
+    shift = _shift(series.events, run_time, agvs)
+    if shift is not None:
+        agvs = shift[1]
     run = rec.run
     return RunAnalysis(
         path=str(rec.path),
@@ -175,7 +185,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         truncated=rec.truncated,
         dt=dt,
         ticks=int(series.tick[-1]) if len(series.tick) else 0,
-        run_time=float(series.time[-1]) if len(series.time) else 0.0,
+        run_time=run_time,
         arrived=sum(a.status == ARRIVED for a in agvs),
         collisions=len(collisions),
         path_length=_mean(a.path_length for a in agvs),
@@ -198,7 +208,28 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         reservation_waits=len(waits_for),
         self_crossings=sum(a.self_crossings for a in agvs),
         recoveries=sum(a.recoveries for a in agvs),
+        tasks=None if shift is None else shift[0],
     )
+
+
+def _shift(events: list[dict], run_time: float, agvs: list[AgvAnalysis]):
+    """A shift's ``tasks`` block and its AGVs with their task fields; None without tasks."""
+    task_events = [e for e in events if is_task_event(e)]
+    if not task_events:
+        return None
+    stats = shift_stats(task_events, run_time)
+    out = []
+    for a in agvs:
+        done = stats.deliveries.get(a.name, 0)
+        out.append(
+            replace(
+                a,
+                deliveries=done,
+                utilisation=stats.busy.get(a.name, 0.0) / run_time if run_time else None,
+                distance_per_task=a.distance / done if done else None,
+            )
+        )
+    return stats.to_json(), out
 
 
 def _agv(

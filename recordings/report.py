@@ -10,6 +10,7 @@ from recordings.analysis import AgvAnalysis, RunAnalysis, compare, json_ready
 from recordings.text_table import text_table
 
 TABLE_WIDTH = 100  # columns the default tables fit in (--wide: every column)
+SHIFT = "shift"  # a column of the default table of a shift only (fleet.missions)
 
 # per-AGV table: (header, unit, AgvAnalysis field, format, in the default table)
 AGV_COLUMNS = (
@@ -34,7 +35,12 @@ AGV_COLUMNS = (
     ("recoveries", "", "recoveries", "{}", False),
     ("planning", "mean ms", "plan_time_mean_ms", "{:.2f}", False),
     ("planning", "p95 ms", "plan_time_p95_ms", "{:.2f}", False),
+    ("tasks", "done", "deliveries", "{}", SHIFT),
+    ("busy", "%", "utilisation", "{:.0%}", SHIFT),
+    ("per task", "m", "distance_per_task", "{:.1f}", SHIFT),
 )
+# a shift's default table: its task columns instead of these, to fit in TABLE_WIDTH
+NOT_IN_SHIFT = ("arrival_time", "path_length", "rms_jerk")
 HIDDEN_NOTE = (
     "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, planning, waiting, recoveries)"
 )
@@ -54,7 +60,7 @@ def _state(run: RunAnalysis) -> str:
 
 def run_table(run: RunAnalysis, wide: bool = False) -> str:
     """The per-AGV table of one run and a line for the run (``wide``: every column)."""
-    columns = [c for c in AGV_COLUMNS if wide or c[4]]
+    columns = [c for c in AGV_COLUMNS if wide or _shown(c, run.tasks is not None)]
     header = [[c[0] for c in columns], [c[1] for c in columns]]
     rows = [[_cell(getattr(a, c[2]), c[3]) for c in columns] for a in run.agvs]
     line = (
@@ -64,8 +70,32 @@ def run_table(run: RunAnalysis, wide: bool = False) -> str:
     )
     table = text_table(header, rows, right_from=2) if run.agvs else "(no AGVs)"
     note = "" if wide or not run.agvs else "\n" + HIDDEN_NOTE
-    lines = f"{_loops_line(run)}{_traffic_line(run)}{_recoveries_line(run)}"
+    lines = f"{_tasks_line(run)}{_loops_line(run)}{_traffic_line(run)}{_recoveries_line(run)}"
     return f"{table}\n{line}{lines}{note}"
+
+
+def _shown(column, shift: bool) -> bool:
+    """Whether ``column`` is in the default table of a run (``shift``: one with tasks)."""
+    if column[4] == SHIFT:
+        return shift
+    return column[4] and not (shift and column[2] in NOT_IN_SHIFT)
+
+
+def _tasks_line(run: RunAnalysis) -> str:
+    """A shift's throughput, when the run had tasks."""
+    t = run.tasks
+    if t is None:
+        return ""
+
+    def s(key: str) -> str:
+        return "-" if t[key] is None else f"{t[key]:.1f} s"
+
+    rate = "-" if t["throughput_per_hour"] is None else f"{t['throughput_per_hour']:.1f}"
+    return (
+        f"\ntasks: {t['requested']} requested, {t['assigned']} assigned, {t['delivered']} "
+        f"delivered ({rate} an hour)\n       task time mean {s('task_time_mean')}, "
+        f"p95 {s('task_time_p95')}; queue time mean {s('queue_time_mean')}"
+    )
 
 
 def _loops_line(run: RunAnalysis) -> str:
@@ -147,14 +177,17 @@ def to_csv(runs: list[RunAnalysis]) -> str:
     row per AGV; the recording's facts in front of every row. A metric that does not
     apply to a row's kind is empty; booleans are yes/no."""
     agv_fields = [f.name for f in fields(AgvAnalysis)]
-    run_metrics = {f.name for f in fields(RunAnalysis)} - {"agvs", *CSV_RUN_FIELDS}
+    run_metrics = {f.name for f in fields(RunAnalysis)} - {"agvs", "tasks", *CSV_RUN_FIELDS}
     metrics = [*agv_fields, *sorted(run_metrics - set(agv_fields))]
+    shift = next((r.tasks for r in runs if r.tasks), None)
+    metrics += [f"tasks_{key}" for key in shift or ()]  # a shift's block, flattened
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(["row", *CSV_RUN_FIELDS, *metrics])
     for run in runs:
         facts = [_csv_value(getattr(run, f)) for f in CSV_RUN_FIELDS]
         values = asdict(run)
+        values.update({f"tasks_{k}": v for k, v in (run.tasks or {}).items()})
         writer.writerow(["run", *facts, *(_csv_value(values.get(f)) for f in metrics)])
         for agv in run.agvs:
             values = asdict(agv)

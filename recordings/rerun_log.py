@@ -92,12 +92,14 @@ def layout_of(messages) -> tuple[list[str], Bounds | None, float]:
     return names, bounds, end_time
 
 
-def send_recording(stream: rr.RecordingStream, messages, follow=None, rate=None) -> None:
+def send_recording(
+    stream: rr.RecordingStream, messages, follow=None, rate=None, stations=()
+) -> None:
     """Send a whole recording's blueprint (options: see ``rerun_blueprint.blueprint``),
-    then the recording converted."""
+    then the recording converted (``stations``: a shift's, ``rerun_tasks.stations_of``)."""
     names, bounds, end_time = layout_of(messages)
     stream.send_blueprint(blueprint(names, bounds, end_time, follow=follow, rate=rate))
-    maker = RowMaker(recording_dt(messages))
+    maker = RowMaker(recording_dt(messages), stations)
     columns = Columns(stream)
     columns.add(fleet_style_rows())
     for m in messages:
@@ -110,9 +112,9 @@ class Live:
     the rows, when the map or an AGV appears. ``send()`` sends what is waiting (call it
     at the end)."""
 
-    def __init__(self, stream: rr.RecordingStream, dt: float):
+    def __init__(self, stream: rr.RecordingStream, dt: float, stations=()):
         self._stream = stream
-        self._maker = RowMaker(dt)
+        self._maker = RowMaker(dt, stations)
         self._columns = Columns(stream)
         self._shown: tuple | None = None  # (AGVs, map bounds) of the blueprint sent
         self._due = time.monotonic() + LIVE_PERIOD

@@ -36,7 +36,8 @@ Entity paths (everything on the map under ``world``, in world coordinates):
                                   from the plans: replan, no path)
     velocity/<q>/<name>           Scalars, q in vx, vy (body frame), speed (|v|), omega
 
-Beside them ``recordings.rerun_fleet`` makes ``fleet/...``: the fleet's counts per tick.
+Beside them ``recordings.rerun_fleet`` makes ``fleet/...``: the fleet's counts per tick,
+and ``recordings.rerun_tasks`` a shift's stations and each AGV's current task.
 """
 
 from __future__ import annotations
@@ -59,6 +60,7 @@ from planner.traffic.zones import HELD
 from recordings import rerun_kinds as kinds
 from recordings.map_frame import map_origin, map_size
 from recordings.palette import agv_color
+from recordings.rerun_tasks import TaskRows, station_rows, task_styles
 from recordings.series import map_grid
 
 TIMELINE = "sim_time"
@@ -137,7 +139,8 @@ class RowMaker:
     own formula).
     """
 
-    def __init__(self, dt: float):
+    def __init__(self, dt: float, stations=()):
+        """``stations``: a shift's, as ``rerun_tasks.stations_of`` gives them."""
         self.dt = dt
         self.agv_names: list[str] = []
         self.map_bounds: tuple[float, float, float, float] | None = None  # x0, y0, x1, y1 (m)
@@ -153,7 +156,8 @@ class RowMaker:
         self._waiting_shown: set[str] = set()
         self._roadmap_of: dict | None = None  # the map, until the roadmap is drawn
         self._reserved_shown: set[str] = set()
-        self._pending = world_rows()
+        self._pending = world_rows() + station_rows(list(stations), Row)
+        self._tasks = TaskRows(agv_path, Row)
 
     def feed(self, topic: str, data: dict) -> list[Row]:
         """The rows of one message (MessageError if it lacks what its topic carries)."""
@@ -231,6 +235,7 @@ class RowMaker:
             "reserved": rr.LineStrips2D.from_fields(
                 colors=faded, radii=rr.Radius.ui_points(4.0), draw_order=14.0
             ),
+            **task_styles(color),
         }
         for part, style in styles.items():
             rows.append(Row(agv_path(name, part), None, None, [style]))
@@ -246,6 +251,7 @@ class RowMaker:
             self._map_msg = None
         self._waiting(t, data, rows)
         self._reserved(t, data, rows)
+        rows.extend(self._tasks.rows(t, data))
         for s in data["agvs"]:
             name = s["name"]
             self._meet(name, rows)

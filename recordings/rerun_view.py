@@ -20,6 +20,7 @@ import rerun as rr
 from bridge.messages import to_dict
 from recordings.rerun_log import Live, send_recording
 from recordings.rerun_server import RerunError, WebServer, open_viewer, require_display
+from recordings.rerun_tasks import stations_of
 
 APP_ID = "agv-fleet"
 FLUSH_TIMEOUT = 30.0
@@ -95,7 +96,8 @@ class Outputs:
         """Send a whole recording; the viewer opens paused at its start, or playing it
         at ``rate`` x real time, and on the tab of the AGV named ``follow``, if given.
         (The viewer plays it: sending it paced made the web viewer fall behind.)"""
-        send_recording(self.stream, recording.messages, follow, rate)
+        stations = stations_of(recording.scenario_text)
+        send_recording(self.stream, recording.messages, follow, rate, stations)
 
     def hold(self) -> None:
         """With the web viewer: keep serving until Ctrl-C (or the server ends)."""
@@ -142,9 +144,11 @@ class LiveView:
     period, which dates AGV states). Use it as a context manager; ``hold()`` after
     the run keeps the web viewer up until Ctrl-C."""
 
-    def __init__(self, dt: float, *, save: Path | str | None = None, web: bool = False):
+    def __init__(
+        self, dt: float, *, save: Path | str | None = None, web: bool = False, scenario_text=""
+    ):
         self._outputs = Outputs(save=save, web=web)
-        self._live = Live(self._outputs.stream, dt)
+        self._live = Live(self._outputs.stream, dt, stations_of(scenario_text))
 
     def __enter__(self) -> LiveView:
         self._outputs.__enter__()

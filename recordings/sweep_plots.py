@@ -8,7 +8,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from recordings.sweep_report import UNITS, SweepEntry, variant_label
+from recordings.sweep_report import UNITS, SweepEntry, variant_label, variant_stats
 from recordings.sweep_stats import metric_order, numeric_fields
 
 DPI = 100
@@ -38,7 +38,55 @@ def save_box_plots(entries: Sequence[SweepEntry], out_dir: Path, title: str) -> 
         path = out_dir / f"{name}.png"
         figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
         paths.append(path)
-    return paths
+    sizing = save_sizing_plot(entries, out_dir, title)
+    return paths + ([sizing] if sizing else [])
+
+
+THROUGHPUT, TASK_TIME = "tasks.throughput_per_hour", "tasks.task_time_mean"
+SIZING_PLOT = "fleet-sizing.png"
+
+
+def save_sizing_plot(entries: Sequence[SweepEntry], out_dir: Path, title: str) -> Path | None:
+    """A shift swept over one numeric key (``agvs.count``): throughput and task time
+    against it, the mean with its 95 % interval and every run as a dot, in
+    ``fleet-sizing.png``. None when the sweep is not one."""
+    keys = list(entries[0].variant) if entries else []
+    if len(keys) != 1 or not all(isinstance(e.variant[keys[0]], int | float) for e in entries):
+        return None
+    stats = variant_stats(entries)
+    if not all(THROUGHPUT in v.metrics for v in stats):
+        return None
+    figure = Figure(figsize=(7.5, 4.8))
+    ax = figure.add_subplot()
+    twin = ax.twinx()
+    for axis, name, color, marker in ((ax, THROUGHPUT, "tab:blue", "o"),
+                                      (twin, TASK_TIME, "tab:red", "s")):  # fmt: skip
+        xs = [v.variant[keys[0]] for v in stats if name in v.metrics]
+        means = [v.metrics[name].mean for v in stats if name in v.metrics]
+        half = [(v.metrics[name].ci95[1] - v.metrics[name].ci95[0]) / 2
+                for v in stats if name in v.metrics]  # fmt: skip
+        axis.errorbar(xs, means, yerr=half, color=color, marker=marker, capsize=4,
+                      label=f"{name} ({UNITS[name]})")  # fmt: skip
+        runs = [(e.variant[keys[0]], numeric_fields(e.run).get(name)) for e in entries]
+        axis.plot(*zip(*[r for r in runs if r[1] is not None], strict=True), ".",
+                  color=color, alpha=0.4)  # fmt: skip
+        axis.set_ylabel(f"{name.split('.')[-1].replace('_', ' ')} ({UNITS[name]})", color=color)
+        axis.set_ylim(bottom=0)
+    ax.set_xscale("log", base=2)
+    ax.set_xticks(sorted({v.variant[keys[0]] for v in stats}))
+    ax.set_xticklabels([str(x) for x in sorted({v.variant[keys[0]] for v in stats})])
+    ax.set_xlabel(keys[0])
+    samples = list(entries[0].sample)
+    over = f" over {', '.join(samples)}" if samples else ""
+    ax.set_title(f"{title}: throughput and task time against {keys[0]}{over}\n"
+                 "mean ± 95 % interval, dots: runs", fontsize="medium")  # fmt: skip
+    ax.grid(True, lw=0.4, alpha=0.6)
+    figure.legend(loc="lower center", ncol=2, fontsize="small", bbox_to_anchor=(0.5, 0.0))
+    figure.tight_layout(rect=(0, 0.06, 1, 1))
+    FigureCanvasAgg(figure)
+    path = out_dir / SIZING_PLOT
+    figure.savefig(path, dpi=DPI, pil_kwargs={"optimize": True})
+    return path
 
 
 def box_figure(name: str, groups, keys: list[str], samples: list[str], title: str) -> Figure:

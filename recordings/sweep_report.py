@@ -17,6 +17,8 @@ from recordings.sweep_stats import VariantStats, aggregate, numeric_fields
 from recordings.text_table import text_table
 
 UNITS = {key: unit for key, _, unit in COMPARED} | {"dt": "s", "ticks": ""}
+UNITS |= {f"tasks.{k}": "s" for k in ("task_time_mean", "task_time_p95", "queue_time_mean")}
+UNITS["tasks.throughput_per_hour"] = "1/h"
 STATS_FIELDS = ("n", "mean", "median", "std", "min", "max", "ci95_low", "ci95_high")
 
 

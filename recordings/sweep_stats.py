@@ -22,6 +22,9 @@ from recordings.analysis import COMPARED, json_ready
 # measured wall time, not simulated: they differ between two runs of the same scenario
 WALL_CLOCK_METRICS = ("plan_time_mean_ms", "plan_time_p95_ms")
 CONFIDENCE = 0.95
+TASKS = "tasks"  # the run-level block of a shift
+TASK_METRICS = ("throughput_per_hour", "delivered", "task_time_mean", "task_time_p95",
+                "queue_time_mean", "requested", "assigned")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -58,17 +61,21 @@ class VariantStats:
 
 
 def numeric_fields(run: dict) -> dict[str, float | None]:
-    """The numeric fields of a run-level analysis (booleans and texts left out)."""
+    """The numeric fields of a run-level analysis (booleans and texts left out); a shift's
+    ``tasks`` block as ``tasks.<key>`` (``recordings.task_stats``)."""
+    fields = {**run, **{f"{TASKS}.{k}": v for k, v in (run.get(TASKS) or {}).items()}}
     return {
         k: v
-        for k, v in run.items()
+        for k, v in fields.items()
         if v is None or (isinstance(v, int | float) and not isinstance(v, bool))
     }
 
 
 def metric_order(names: set[str]) -> list[str]:
-    """The compared metrics in ``analyze``'s order, then any other in name order."""
-    known = [key for key, _, _ in COMPARED if key in names]
+    """A shift's task metrics, the compared metrics in ``analyze``'s order, then any other
+    in name order."""
+    shift = [f"{TASKS}.{k}" for k in TASK_METRICS]  # first: what a shift is swept for
+    known = [key for key in (*shift, *(key for key, _, _ in COMPARED)) if key in names]
     return known + sorted(names - set(known))
 
 

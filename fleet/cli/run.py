@@ -164,7 +164,12 @@ def run(args: argparse.Namespace) -> int:
                 from recordings.rerun_view import LiveView
 
                 view = stack.enter_context(
-                    LiveView(scenario.dt, save=args.rerun_save, web=args.rerun_web)
+                    LiveView(
+                        scenario.dt,
+                        save=args.rerun_save,
+                        web=args.rerun_web,
+                        scenario_text=scenario.source,
+                    )
                 )
             foxglove = None
             if args.foxglove is not None:

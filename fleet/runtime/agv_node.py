@@ -18,9 +18,18 @@ import numpy as np
 
 from bridge import keys
 from bridge.messages import AgvCommand, AgvState, PlanMsg, Tick, TrajectoryMsg
+from fleet.runtime.world import HELD
 from fleet.scenario import RESERVATIONS, Scenario
 from planner.core.motion import moving_discs
-from planner.core.status import DRIVING, FAILED, FINISHED, INITIAL, REPLAN, TRAFFIC, WAITING
+from planner.core.status import (
+    DRIVING,
+    FAILED,
+    FINISHED,
+    INITIAL,
+    REPLAN,
+    TRAFFIC,
+    WAITING,
+)
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.nav.fusion import FusionController
@@ -57,12 +66,18 @@ class AgvNode:
         self.scenario = scenario
         self.spec = scenario.agv(name)
         self.name = name
-        self.controller = FusionController(scenario.grid, self.spec.goal, self.spec.config)
-        self.guard = traffic_guard(scenario, self.controller)
-        self._parked: frozenset[str] = frozenset()
         self._stopped_at: dict[str, float] = {}  # sim time each other AGV stopped for good
-        self._started = False
         self._index = 0  # where this AGV's state was in the last tick's list
+        self._drive_to(self.spec.goal)
+
+    def _drive_to(self, goal) -> None:
+        """A controller for ``goal``: at the start, and in a shift for each new goal the
+        world gives (it plans from where the AGV stands at the next tick)."""
+        self.goal = tuple(goal)
+        self.controller = FusionController(self.scenario.grid, self.goal, self.spec.config)
+        self.guard = traffic_guard(self.scenario, self.controller)
+        self._parked: frozenset[str] = frozenset()  # told again to the new controller
+        self._started = False
 
     def warm_up(self) -> None:
         """Load (or compile) every numba kernel this node uses, before the run starts
@@ -71,7 +86,8 @@ class AgvNode:
         warm_up(self.scenario.grid, spec.start, spec.goal, spec.config, self.guard)
 
     def on_tick(self, tick: Tick) -> NodeOutput | None:
-        """This AGV's answer to ``tick``; None for a tick that does not list it."""
+        """This AGV's answer to ``tick``; None for a tick that does not list it, or one in
+        which a shift holds it at its goal (``HELD``)."""
         me = self._own_state(tick)
         if me is None:
             return None
@@ -80,11 +96,17 @@ class AgvNode:
         start_heading = None
         if me.status == FAILED:  # the world gave up on this AGV: stand still
             return NodeOutput(self._command(tick, (0.0, 0.0, 0.0), FAILED))
+        if me.status in HELD:  # held at its goal by a shift (a dwell, or idle at home):
+            return None  # it stands there, and the world does not wait for its answer
+        if tick.assignments:
+            goal = self._assigned_goal(tick)
+            if goal != self.goal:
+                self._drive_to(goal)
         if not self._started:
             self._started = True
             pose, plan = self.controller.start(pose)
             plan_msg = self._plan_msg(tick, plan, INITIAL)
-            if pose[2] != me.theta:
+            if pose[2] != me.theta and tick.tick == 0:
                 start_heading = float(pose[2])
         self._sense(tick, pose)
         self._park(tick)
@@ -131,6 +153,11 @@ class AgvNode:
                 self.name, tick.tick, step.trajectory[:, :2].round(4).tolist()
             )
         return NodeOutput(command, plan_msg, trajectory)
+
+    def _assigned_goal(self, tick: Tick) -> tuple[float, float]:
+        """This AGV's goal in a shift's ``tick`` (its own goal if the tick has none)."""
+        mine = next((a for a in tick.assignments if a.name == self.name), None)
+        return self.goal if mine is None else tuple(mine.goal)
 
     def _reservation(self, tick: Tick) -> Reservation | None:
         """This AGV's reservation in ``tick`` (traffic mode "reservations"), else None."""

@@ -37,7 +37,7 @@ def _run_nodes(scenario: Scenario, outbox: Outbox | None, progress) -> RunSummar
 
     def collect(tick: Tick, world: World) -> dict[str, AgvCommand]:
         replies = {}
-        for name in world.live_agvs():
+        for name in world.awaited():
             out = nodes[name].on_tick(tick)
             publish_output(outbox, out)
             replies[name] = out.command

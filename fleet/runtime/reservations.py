@@ -38,7 +38,10 @@ class Reservations:
         agents = [(a.name, a.start, a.goal) for a in scenario.agvs]
         stopping = [stopping_distance(a.config.dwa) for a in scenario.agvs]
         try:
-            return cls(Schedule(roadmap, agents, stopping))
+            schedule = Schedule(roadmap, agents, stopping)
+            for station in scenario.missions.stations if scenario.missions else ():
+                schedule.node_of(f"station {station.name!r}", station.position, "position")
+            return cls(schedule)
         except ScheduleError as err:
             raise ScenarioError(f"[traffic] mode = reservations: {err}") from None
 
@@ -48,6 +51,11 @@ class Reservations:
         self.cpu_s += time.thread_time() - t0
         self.updates += 1
         return [Event(tick, now, e.kind, e.agvs, e.detail) for e in self.schedule.drain_events()]
+
+    def set_goal(self, name: str, goal: Point) -> None:
+        """A new goal of an AGV of a shift (``fleet.missions``): planned towards from the
+        next update."""
+        self.schedule.set_goal(name, goal)
 
     def finish(self, name: str, status: str, position: Point) -> None:
         """An AGV stopped for good: parked at its goal, or a body the plan goes round."""

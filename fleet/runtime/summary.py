@@ -5,12 +5,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from fleet.runtime.world import World
+from fleet.runtime.world import SHIFT_OVER, World
 from planner.core.errors import MapError
 from planner.core.path_metrics import self_crossings
-from planner.core.status import ARRIVED, FINISHED
+from planner.core.status import ARRIVED, FAILED, FINISHED
 from planner.nav.fusion import GLOBAL_ALGORITHM
 from planner.route.global_planner import plan_global
+from recordings.task_stats import shift_stats
 from recordings.text_table import text_table
 
 
@@ -42,9 +43,14 @@ class RunSummary:
     agvs: tuple[AgvSummary, ...]
     traffic: str = ""  # the traffic mode the run used (zones or reservations)
 
+    tasks: dict | None = None  # a shift's throughput (recordings.task_stats)
+
     @property
     def success(self) -> bool:
-        """Every AGV arrived and nothing collided."""
+        """Every AGV arrived and nothing collided; for a shift: it ran to its end with
+        no AGV failed and nothing collided."""
+        if self.end_reason == SHIFT_OVER:
+            return self.collisions == 0 and all(a.status != FAILED for a in self.agvs)
         return self.collisions == 0 and all(a.status == ARRIVED for a in self.agvs)
 
     def to_json(self) -> dict:
@@ -76,6 +82,7 @@ class RunSummary:
                 }
                 for a in self.agvs
             ],
+            **({"tasks": self.tasks} if self.tasks is not None else {}),
         }
 
     def table(self) -> str:
@@ -109,9 +116,13 @@ class RunSummary:
             for a in self.agvs
         ]
         arrived = sum(a.status == ARRIVED for a in self.agvs)
+        done = f"{arrived}/{len(self.agvs)} arrived"
+        if self.tasks is not None:
+            t = self.tasks
+            done = f"{t['delivered']}/{t['requested']} tasks delivered"
         lines = [
             text_table(header, rows, right_from=2),
-            f"{self.scenario}: {arrived}/{len(self.agvs)} arrived, {self.collisions} collisions, "
+            f"{self.scenario}: {done}, {self.collisions} collisions, "
             f"{self.sim_time:.1f} s simulated in {self.wall_time:.2f} s ({self.end_reason})",
         ]
         lines += [f"{a.name} failed: {a.failure}" for a in self.agvs if a.failure]
@@ -122,7 +133,9 @@ def summarize(world: World, wall_time: float) -> RunSummary:
     agvs = []
     for name, r in world.records.items():
         status = r.status
-        if status not in FINISHED:
+        if status not in FINISHED and world.missions is not None:
+            status = world.states[name].status  # where the shift's end found it
+        elif status not in FINISHED:
             status = "timeout" if world.end_reason == "time limit" else status
         agvs.append(
             AgvSummary(
@@ -150,17 +163,29 @@ def summarize(world: World, wall_time: float) -> RunSummary:
         end_reason=world.end_reason,
         agvs=tuple(agvs),
         traffic=world.scenario.traffic_mode,
+        tasks=_tasks(world),
     )
+
+
+def _tasks(world: World) -> dict | None:
+    """A shift's ``tasks`` block, from its task events as ``analyze`` reads them."""
+    if world.missions is None:
+        return None
+    events = [
+        {"kind": e.kind, "time": e.time, "agvs": [e.agv], "detail": e.detail}
+        for e in world.missions.log
+    ]
+    return shift_stats(events, world.time).to_json()
 
 
 def route_length(scenario, name: str) -> float | None:
     """Length (m) of the route AGV ``name`` planned first: its key nodes from its start to
     its goal, planned again here exactly as the AGV plans it (same map, variant, profile
     and clearance), so both run modes state it without asking the AGVs. None for DWA
-    alone (no global route) or when no path exists."""
+    alone (no global route), when no path exists, or in a shift."""
     spec = scenario.agv(name)
     algorithm = GLOBAL_ALGORITHM.get(spec.config.algorithm)
-    if algorithm is None:
+    if algorithm is None or scenario.missions is not None:  # a shift: a route per task
         return None
     try:
         plan = plan_global(

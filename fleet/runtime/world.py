@@ -17,6 +17,7 @@ import numpy as np
 
 from bridge.messages import AgvCommand, AgvState, Event, MapMsg, ObstacleState, Tick
 from fleet.runtime.agv_gaps import agv_gaps
+from fleet.runtime.missions import MissionControl
 from fleet.runtime.reservations import Reservations
 from fleet.runtime.traffic_events import traffic_events
 from fleet.scenario import Scenario
@@ -30,6 +31,8 @@ from planner.core.status import (
     END,
     FAILED,
     FINISHED,
+    LOADING,
+    PARKED,
     RECOVERY,
     REFUSED,
     WAITING,
@@ -40,6 +43,8 @@ from planner.traffic.guard import ROUTE_POINTS
 from planner.traffic.zones import Intent
 
 INTERRUPTED = "interrupted"  # the end reason of a run ended by Ctrl-C or SIGTERM
+HELD = (LOADING, PARKED)  # statuses of an AGV a shift holds at its goal (fleet.missions)
+SHIFT_OVER = "shift over"  # the end reason of a shift at its end (or its time limit)
 
 
 @dataclass
@@ -92,10 +97,12 @@ class World:
         self.ended = False
         self.end_reason = ""
         self.reservations = Reservations.of(scenario)  # None: the zone rule
+        self.missions = MissionControl(scenario) if scenario.missions else None
 
     # --- the clock ----------------------------------------------------------------
     def first_tick(self) -> Tick:
         self._check_contacts()
+        self._dispatch()
         self._reserve()
         return self._make_tick()
 
@@ -103,6 +110,12 @@ class World:
         """AGVs whose answer the next tick waits for: all but the failed ones (an
         arrived AGV keeps answering, parked, so every tick has every AGV's state)."""
         return [n for n, r in self.records.items() if r.status != FAILED]
+
+    def awaited(self) -> list[str]:
+        """The live AGVs whose answer the next tick waits for: in a shift, not those it
+        holds at their goal (``HELD``): the world knows their answer, standing still, and
+        their nodes send none (idle AGVs cost no round trip on the bus)."""
+        return [n for n in self.live_agvs() if self.states[n].status not in HELD]
 
     def _running(self) -> list[str]:
         return [n for n, r in self.records.items() if r.status not in FINISHED]
@@ -114,23 +127,50 @@ class World:
         self.time = round(self.tick * self.scenario.dt, 9)
         for name in self.live_agvs():
             command = commands.get(name)
+            if command is None and self.states[name].status in HELD:
+                command = AgvCommand(name, self.tick, 0.0, 0.0, 0.0, ARRIVED)  # stands still
             if command is not None:
                 self._apply(name, command)
         self._refresh_temporary()
         self._check_contacts()
+        self._dispatch()
         if not self._running():
             self._end(self._done_reason())
         elif self.time >= self.scenario.time_limit - 1e-9:
-            self._end("time limit")
+            self._end(SHIFT_OVER if self.missions else "time limit")
         if self.ended:
             return None
         self._reserve()
         return self._make_tick()
 
+    def _dispatch(self) -> None:
+        """A shift: the dispatcher's decisions for this tick, its new goals to the traffic
+        schedule, and the status of every AGV it holds at a goal (``fleet.runtime.missions``)."""
+        if self.missions is None:
+            return
+        live = self.live_agvs()
+        positions = {n: (self.states[n].x, self.states[n].y) for n in live}
+        events, goals = self.missions.update(positions, self.tick, self.time)
+        self.events.extend(events)
+        if self.reservations is not None:
+            for name, goal in goals.items():
+                self.reservations.set_goal(name, goal)
+        for name in live:
+            state = self.states[name]
+            state.status = self.missions.status(name, state.status)
+
+    def _goal(self, name: str):
+        """Where AGV ``name`` is going: its goal, or in a shift its current task's."""
+        return self.missions.goal(name) if self.missions else self.scenario.agv(name).goal
+
     def _reserve(self) -> None:
         """Traffic mode "reservations": the schedule's step for this tick (its events too)."""
         if self.reservations is not None:
-            running = {n: (self.states[n].x, self.states[n].y) for n in self._running()}
+            running = {
+                n: (self.states[n].x, self.states[n].y)
+                for n in self._running()
+                if self.states[n].status not in HELD  # a shift holds it at its goal node:
+            }  # frozen there in the plan, it needs no reservation (idle AGVs cost ~nothing)
             self.events.extend(self.reservations.update(running, self.tick, self.time))
 
     def _apply(self, name: str, command: AgvCommand) -> None:
@@ -149,8 +189,9 @@ class World:
                 self._refuse(name, "a start heading after tick 0 or outside the paper profile")
         status = command.status
         requested = (command.vx, command.vy, command.omega)
-        if status == ARRIVED and math.dist(pose[:2], spec.goal) > spec.config.goal_tolerance + 1e-9:
-            far = math.dist(pose[:2], spec.goal)
+        goal = self._goal(name)
+        if status == ARRIVED and math.dist(pose[:2], goal) > spec.config.goal_tolerance + 1e-9:
+            far = math.dist(pose[:2], goal)
             self._refuse(name, f"arrival claimed {far:.2f} m from the goal")
             status = DRIVING
         if status in FINISHED:
@@ -179,7 +220,9 @@ class World:
             name, self.tick, x, y, theta, *velocity, old.radius, status,
             command.target, command.plan_time_ms, command.failure if status == FAILED else "",
         )  # fmt: skip
-        if status in FINISHED and record.status not in FINISHED:
+        if status == ARRIVED and self.missions:
+            self.missions.at_goal.add(name)  # a shift goes on: the dispatcher answers
+        elif status in FINISHED and record.status not in FINISHED:
             self._finish(name, status, command.failure or status)
 
     def _take_intent(self, name: str, intent: Intent | None, status: str) -> None:
@@ -243,6 +286,8 @@ class World:
 
     # --- internals ----------------------------------------------------------------
     def _finish(self, name: str, status: str, why: str) -> None:
+        if self.missions is not None:
+            self.missions.retire(name)  # only a failure ends an AGV's shift
         if self.reservations is not None:
             state = self.states[name]
             self.reservations.finish(name, status, (state.x, state.y))
@@ -268,6 +313,7 @@ class World:
             temporary=[list(c) for c in self._temporary_shown],
             intents=self._claims(),
             reservations=self.reservations.current if self.reservations is not None else [],
+            assignments=self.missions.assignments() if self.missions else [],
         )
 
     def _claims(self) -> list[Intent]:

@@ -173,7 +173,7 @@ class WorldServer:
         started = sent = time.monotonic()
         while not interrupted():  # Ctrl-C: the clock ends the run at this tick
             self._update_liveliness()
-            waiting = [n for n in self.world.live_agvs() if n not in replies]
+            waiting = [n for n in self.world.awaited() if n not in replies]
             if not waiting:
                 return replies
             now = time.monotonic()

@@ -8,6 +8,11 @@ or its index (``obstacles.walker.start_at``, ``agvs.0.max_speed``,
 value has the right type is left to the scenario's own checks: the edited document
 is parsed again by ``fleet.scenario.parse_scenario``, so every scenario error applies.
 
+One key is not a path: ``agvs.count`` (a positive integer N) makes the fleet N AGVs,
+``agv1`` .. ``agvN``, each like the file's first ``[[agvs]]`` entry, started on the first N
+stations of group ``parking`` in the file's order (fleet sizing: a shift's AGVs return
+to their starts when idle).
+
 Values are TOML values (``1.5``, ``true``, ``[19.5, 19.5]``, ``"fusion"``); a bare word
 is a string (``fusion``). ``START:STOP:STEP`` is every number from START to STOP
 inclusive in steps of STEP (``0:40:2`` is 21 values).
@@ -22,8 +27,10 @@ from dataclasses import dataclass
 import tomlkit
 from tomlkit.items import AoT, Array
 
+from fleet.missions.spec import PARKING
 from fleet.toml_schema import ScenarioError
 
+AGV_COUNT = "agvs.count"
 MAX_RANGE_VALUES = 10_000  # a typo such as 0:40:0.0001 is an error, not a sweep of 400k runs
 
 
@@ -112,6 +119,9 @@ def _range(text: str) -> list | None:
 
 def apply(doc: tomlkit.TOMLDocument, key: str, value) -> None:
     """Set ``key`` (dotted) to ``value`` in the TOML document ``doc``, in place."""
+    if key == AGV_COUNT:
+        set_agv_count(doc, value)
+        return
     parts = key.split(".")
     node = doc
     for depth, part in enumerate(parts[:-1]):
@@ -146,3 +156,27 @@ def _entry(items, part: str, where: str):
         if items
         else f"{where}: the list is empty"
     )
+
+
+def set_agv_count(doc: tomlkit.TOMLDocument, count) -> None:
+    """``agvs.count``: ``count`` AGVs like the first, on the first parking stations."""
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise SweepKeyError(f"{AGV_COUNT} must be a positive integer, got {count!r}")
+    stations = doc.get("stations", [])
+    spots = [s["position"] for s in stations if isinstance(s, dict) and s.get("group") == PARKING]
+    if len(spots) < count:
+        raise SweepKeyError(
+            f"{AGV_COUNT} = {count}: the scenario has {len(spots)} stations of group "
+            f"{PARKING!r} to start AGVs on"
+        )
+    agvs = doc.get("agvs") or [{}]
+    template = {k: v for k, v in agvs[0].items() if k not in ("name", "start", "goal")}
+    fleet = tomlkit.aot()
+    for i, spot in enumerate(spots[:count]):
+        entry = tomlkit.table()
+        entry["name"] = f"agv{i + 1}"
+        entry["start"] = list(spot)
+        for k, v in template.items():
+            entry[k] = v
+        fleet.append(entry)
+    doc["agvs"] = fleet

@@ -12,7 +12,11 @@ BLOCKED = "blocked"  # no admissible command this cycle: braking
 WAITING = "waiting"  # holding outside a passage another AGV has (planner/traffic.py)
 ARRIVED = "arrived"
 FAILED = "failed"
-STATUSES = (DRIVING, BLOCKED, WAITING, ARRIVED, FAILED)
+# an AGV of a shift (fleet.missions) the world holds at its goal: at a station for its
+# dwell, or idle at home; the world writes them, an AGV reports ``arrived`` there
+LOADING = "loading"
+PARKED = "parked"
+STATUSES = (DRIVING, BLOCKED, WAITING, ARRIVED, FAILED, LOADING, PARKED)
 FINISHED = (ARRIVED, FAILED)  # an AGV in one of these has ended its run
 
 # the recovery behaviours a stalled AGV runs (planner/recovery.py), reported as it starts
@@ -30,3 +34,13 @@ CLIPPED = "clipped"  # a command beyond the AGV's limits, clipped
 REFUSED = "refused"  # a report the world did not believe
 COLLISION = "collision"
 END = "end"
+
+# the events of a transport task (fleet.missions): a request made, given to an AGV, its
+# load picked up at the end of the pick-up's dwell, delivered at the end of the drop-off's
+REQUESTED, ASSIGNED, PICKED_UP, DELIVERED = TASK_EVENTS = (
+    "requested", "assigned", "picked-up", "delivered",
+)  # fmt: skip
+# what an AGV of a shift is doing (``Assignment.phase`` in the ticks)
+TO_PICK_UP, AT_PICK_UP, TO_DROP_OFF, AT_DROP_OFF, TO_HOME, AT_HOME = TASK_PHASES = (
+    "to pick-up", "at pick-up", "to drop-off", "at drop-off", "to home", "at home",
+)  # fmt: skip

@@ -99,8 +99,8 @@ class Schedule:
             max(RELEASE, 1 + math.ceil(d / step - 1e-9)) for d in stopping or [0.0] * len(agents)
         ]
         self.goal_points = [tuple(a[2]) for a in agents]
-        starts = [self._node(name, start, "start") for name, start, _ in agents]
-        self.goals = [self._node(name, goal, "goal") for name, _, goal in agents]
+        starts = [self.node_of(f"AGV {name!r}", start, "start") for name, start, _ in agents]
+        self.goals = [self.node_of(f"AGV {name!r}", goal, "goal") for name, _, goal in agents]
         for what, nodes in (("start", starts), ("goal", self.goals)):
             seen: dict[int, str] = {}
             for name, node in zip(self.names, nodes, strict=True):
@@ -124,17 +124,19 @@ class Schedule:
         self.events: list[ScheduleEvent] = []
         self._freeze_at_goals()
 
-    def _node(self, name: str, point: Point, what: str) -> int:
+    def node_of(self, who: str, point: Point, what: str) -> int:
+        """The roadmap node of ``who``'s ``what`` (start, goal, a station's position) at
+        ``point``; a ScheduleError when it is on none or too far off its node's centre."""
         node = self.roadmap.node_at(point)
         if node is None:
-            raise ScheduleError(f"AGV {name!r}: its {what} {tuple(point)} is on no roadmap node")
+            raise ScheduleError(f"{who}: its {what} {tuple(point)} is on no roadmap node")
         off = math.dist(point, self.roadmap.centres[node])
         if off > self.roadmap.reach:
             # a body standing off its node reaches into the next one's room (single-lane,
             # 0.5 m cells: an AGV parked at its goal 0.56 m off its node was hit)
             x, y = self.roadmap.centre(node)
             raise ScheduleError(
-                f"AGV {name!r}: its {what} {tuple(point)} is {off:.2f} m from the nearest "
+                f"{who}: its {what} {tuple(point)} is {off:.2f} m from the nearest "
                 f"roadmap node ({x:g}, {y:g}), more than {self.roadmap.reach:.2f} m: put it "
                 "on a node (the lattice of cells the body fits, every "
                 f"{self.roadmap.spacing} cells)"
@@ -146,7 +148,7 @@ class Schedule:
         """A new goal for a running AGV: the plan is made again from the nodes everybody
         holds, towards it."""
         agent = self.names.index(name)
-        self.goals[agent] = self._node(name, goal, "goal")
+        self.goals[agent] = self.node_of(f"AGV {name!r}", goal, "goal")
         self.goal_points[agent] = tuple(goal)
         self.frozen.discard(agent)
         self._plan_again()
