@@ -9,7 +9,8 @@ success (arrived, no collision) out of the episodes that leave a way once
 every walker has stopped (``Episode.way_at_rest``), episodes with a collision, median distance
 driven / shortest path the body fits through (successful episodes), median
 arrival time, median RMS jerk per vehicle (world-frame, over the drive, as
-``recordings.analysis`` defines it) and the wall time. Then the default
+``recordings.analysis`` defines it), median ω sign changes and RMS angular jerk (rad/s³)
+and the wall time. Then the default
 fusion's targets: 100 % success, 0 collisions, median driven/shortest <=
 1.15, RMS jerk <= 0.6 m/s³ at Table-1 limits; a MISS never fails the run.
 
@@ -38,7 +39,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks.nav_episodes import Episode, episodes, make_episode
 from fleet.runtime.inprocess import run_in_process
 from planner.core.status import ARRIVED, FINISHED
-from recordings.analysis import world_velocity
+from recordings.analysis import angular_rms, sign_changes, world_velocity
 
 VARIANTS = (
     ("fusion (default)", "fusion", "default"),
@@ -48,16 +49,24 @@ VARIANTS = (
 )
 
 
-def rms_jerk(states, dt: float) -> float:
-    """RMS of the world-frame jerk over the drive (up to arrival or failure)."""
+def smoothness(states, dt: float) -> dict:
+    """Over the drive (up to arrival or failure), as ``recordings.analysis`` defines them:
+    the RMS world-frame jerk, ω's sign changes and its RMS angular acceleration and jerk."""
     end = next((i for i, s in enumerate(states) if s.status in FINISHED), len(states))
     drive = states[: end + 1]
-    if len(drive) < 3:
-        return 0.0
     col = {k: np.array([getattr(s, k) for s in drive]) for k in ("theta", "vx", "vy", "omega")}
-    velocity = world_velocity(col["theta"], col["vx"], col["vy"], col["omega"], dt)
-    jerk = np.diff(velocity, n=2, axis=0) / dt**2
-    return float(np.sqrt((jerk**2).sum(axis=1).mean()))
+    accel, angular_jerk = angular_rms(col["omega"], dt)
+    out = {
+        "jerk": 0.0,
+        "omega_signs": sign_changes(col["omega"]),
+        "angular_accel": accel or 0.0,
+        "angular_jerk": angular_jerk or 0.0,
+    }
+    if len(drive) >= 3:
+        velocity = world_velocity(col["theta"], col["vx"], col["vy"], col["omega"], dt)
+        jerk = np.diff(velocity, n=2, axis=0) / dt**2
+        out["jerk"] = float(np.sqrt((jerk**2).sum(axis=1).mean()))
+    return out
 
 
 def run_one(job: tuple[Episode, str, str, str]) -> dict:
@@ -79,7 +88,7 @@ def run_one(job: tuple[Episode, str, str, str]) -> dict:
         "collisions": agv.collisions,
         "ratio": agv.distance / episode.shortest,
         "arrival": agv.arrival_time,
-        "jerk": rms_jerk(states, scenario.dt),
+        **smoothness(states, scenario.dt),
         "wall": summary.wall_time,
     }
 
@@ -101,7 +110,7 @@ def table(results: list[dict]) -> str:
     for r in results:
         by[r["variant"]].append(r)
     header = ("variant", "success", "collided", "driven/shortest", "arrival s",
-              "jerk T1", "jerk real", "wall s")  # fmt: skip
+              "jerk T1", "jerk real", "ω signs", "ω jerk", "wall s")  # fmt: skip
     rows = [header]
     for label in (v[0] for v in VARIANTS if v[0] in by):
         rs = by[label]
@@ -115,6 +124,8 @@ def table(results: list[dict]) -> str:
                 _median(r["arrival"] for r in ok),
                 _median(r["jerk"] for r in ok if r["vehicle"] == "table1"),
                 _median(r["jerk"] for r in ok if r["vehicle"] == "realistic"),
+                _median(r["omega_signs"] for r in ok),
+                _median(r["angular_jerk"] for r in ok),
                 f"{sum(r['wall'] for r in rs):.0f}",
             )
         )

@@ -15,8 +15,10 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
   state is its body-frame command turned by the heading it was applied at,
   theta - omega*dt (Eq. 4 turns the command by the heading before the
   step); acceleration and jerk are finite differences over dt, reported as
-  RMS of their norms; the same for the speed |v|. Angular: mean |Δω| per tick
-  and the number of sign changes of ω (exact zeros skipped).
+  RMS of their norms; the same for the speed |v|. Angular: mean |Δω| per tick,
+  the number of sign changes of ω (exact zeros skipped), and the RMS angular
+  acceleration Δω/dt and angular jerk Δ²ω/dt² (the turn rate's own smoothness:
+  the world-frame jerk weighs ω only by the speed it turns).
 - clearance, over every tick: to obstacles (map, temporary cells shown at
   that tick, moving obstacles) and to other AGVs, separately; surface to
   surface, as the world measures it (<= 0 is a contact).
@@ -80,6 +82,8 @@ class AgvAnalysis:
     deliveries: int | None = None
     utilisation: float | None = None  # share of the shift it had a task
     distance_per_task: float | None = None  # m driven per delivery
+    rms_angular_accel: float | None = None  # rad/s², of ω over the drive
+    rms_angular_jerk: float | None = None  # rad/s³
 
 
 @dataclass(frozen=True)
@@ -117,6 +121,8 @@ class RunAnalysis:
     self_crossings: int = 0  # summed over AGVs
     recoveries: int = 0  # summed over AGVs
     tasks: dict | None = None  # a shift's throughput (recordings.task_stats), else None
+    rms_angular_accel: float | None = None  # mean over AGVs
+    rms_angular_jerk: float | None = None
 
     @property
     def label(self) -> str:
@@ -209,6 +215,8 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         self_crossings=sum(a.self_crossings for a in agvs),
         recoveries=sum(a.recoveries for a in agvs),
         tasks=None if shift is None else shift[0],
+        rms_angular_accel=_mean(a.rms_angular_accel for a in agvs),
+        rms_angular_jerk=_mean(a.rms_angular_jerk for a in agvs),
     )
 
 
@@ -280,17 +288,19 @@ def _first_path(plans: list[dict]):
 
 def _smoothness(col: dict[str, np.ndarray], drive: slice, dt: float | None) -> dict:
     omega = col["omega"][drive]
-    turning = np.sign(omega[omega != 0])
     out = {
         "mean_abs_domega": float(np.abs(np.diff(omega)).mean()) if len(omega) > 1 else None,
-        "omega_sign_changes": int(np.count_nonzero(turning[1:] != turning[:-1])),
+        "omega_sign_changes": sign_changes(omega),
         "rms_accel": None,
         "rms_jerk": None,
         "rms_speed_accel": None,
         "rms_speed_jerk": None,
+        "rms_angular_accel": None,
+        "rms_angular_jerk": None,
     }
     if dt is None:
         return out
+    out["rms_angular_accel"], out["rms_angular_jerk"] = angular_rms(omega, dt)
     velocity = world_velocity(col["theta"][drive], col["vx"][drive], col["vy"][drive], omega, dt)
     speed = np.hypot(velocity[:, 0], velocity[:, 1])
     accel = np.diff(velocity, axis=0) / dt
@@ -300,6 +310,19 @@ def _smoothness(col: dict[str, np.ndarray], drive: slice, dt: float | None) -> d
     out["rms_speed_accel"] = _rms(speed_accel)
     out["rms_speed_jerk"] = _rms(np.diff(speed_accel) / dt)
     return out
+
+
+def sign_changes(omega: np.ndarray) -> int:
+    """How often the turn rate ``omega`` changes sign (exact zeros skipped)."""
+    turning = np.sign(omega[omega != 0])
+    return int(np.count_nonzero(turning[1:] != turning[:-1]))
+
+
+def angular_rms(omega: np.ndarray, dt: float) -> tuple[float | None, float | None]:
+    """RMS angular acceleration Δω/dt and RMS angular jerk Δ²ω/dt² of ``omega``, one
+    turn rate per period ``dt`` (None: too few)."""
+    accel = np.diff(omega) / dt
+    return _rms(accel), _rms(np.diff(accel) / dt)
 
 
 def _rms(values: np.ndarray) -> float | None:
@@ -390,6 +413,8 @@ COMPARED = (
     ("rms_jerk", "mean RMS jerk", "m/s³"),
     ("mean_abs_domega", "mean |Δω| per tick", "rad/s"),
     ("omega_sign_changes", "mean ω sign changes", ""),
+    ("rms_angular_accel", "mean RMS angular acceleration", "rad/s²"),
+    ("rms_angular_jerk", "mean RMS angular jerk", "rad/s³"),
     ("min_clearance_obstacles", "min clearance obstacles", "m"),
     ("min_clearance_agvs", "min clearance AGVs", "m"),
     ("replans", "replans", ""),

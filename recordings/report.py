@@ -27,6 +27,8 @@ AGV_COLUMNS = (
     ("jerk RMS", "m/s³", "rms_jerk", "{:.3f}", True),
     ("mean |Δω|", "rad/s", "mean_abs_domega", "{:.4f}", False),
     ("ω sign", "changes", "omega_sign_changes", "{}", False),
+    ("ω accel RMS", "rad/s²", "rms_angular_accel", "{:.3f}", False),
+    ("ω jerk RMS", "rad/s³", "rms_angular_jerk", "{:.3f}", False),
     ("obstacle", "gap m", "min_clearance_obstacles", "{:.2f}", True),
     ("AGV", "gap m", "min_clearance_agvs", "{:.2f}", True),
     ("collisions", "", "collisions", "{}", True),
@@ -42,7 +44,8 @@ AGV_COLUMNS = (
 # a shift's default table: its task columns instead of these, to fit in TABLE_WIDTH
 NOT_IN_SHIFT = ("arrival_time", "path_length", "rms_jerk")
 HIDDEN_NOTE = (
-    "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, planning, waiting, recoveries)"
+    "(--wide adds turns, turning angle, loops, |Δω|, ω sign changes, ω acceleration and jerk,\n"
+    " planning, waiting, recoveries)"
 )
 
 

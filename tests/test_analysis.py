@@ -124,6 +124,10 @@ def test_omega_sign_changes_and_mean_change_over_the_drive_only(tmp_path):
     a = analyze(write(tmp_path / "r.mcap", [tick(s.tick, [s]) for s in states])).agvs[0]
     assert a.omega_sign_changes == 3  # + + | - - | + + + | -  (zeros skipped)
     assert a.mean_abs_domega == pytest.approx(np.abs(np.diff(omegas)).mean())
+    angular_accel = np.diff(omegas) / DT  # the parked ticks after arrival left out
+    assert a.rms_angular_accel == pytest.approx(np.sqrt((angular_accel**2).mean()))
+    jerk = np.diff(angular_accel) / DT
+    assert a.rms_angular_jerk == pytest.approx(np.sqrt((jerk**2).mean()))
     assert a.arrival_time == pytest.approx(11 * DT)
     assert a.status == "arrived"
 

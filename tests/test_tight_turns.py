@@ -7,6 +7,8 @@ import itertools
 import math
 from dataclasses import replace
 
+import numpy as np
+
 from benchmarks import traffic_cases as tc
 from bridge import keys
 from fleet.runtime.inprocess import run_in_process
@@ -25,6 +27,7 @@ from planner.nav.tight_turns import (
     corner,
     room_ahead,
 )
+from recordings.analysis import sign_changes
 
 RADIUS = 0.3
 
@@ -95,6 +98,22 @@ def test_the_straight_approach_holds_its_heading_without_chatter():
     flips = sum(1 for a, b in itertools.pairwise(omegas) if a * b < 0)
     assert flips <= 1
     assert abs(math.remainder(pose[2], math.tau)) < math.radians(0.5)  # faces the node
+
+
+def test_the_faced_approach_does_not_chase_rounding():
+    # off the axes a period's turn closes the heading error only to rounding (~1e-16 rad):
+    # chasing it drove omega of +-1e-15 rad/s, whose sign flipped every tick or two
+    config = DwaConfig(max_speed=1.0, max_accel=0.5)
+    node = (6.0, 4.0)
+    pose, command = (0.0, 0.0, math.atan2(4.0, 6.0) + 0.02), (0.3, 0.0, 0.0)
+    omegas = []
+    while math.dist(pose[:2], node) > 0.6:  # nearer than FACE_FROM the turn rate brakes
+        command = approach_command(config, pose, command, node, config.max_speed)
+        pose = step_pose(pose, command, config.dt)
+        omegas.append(command[2])
+    rounding = [w for w in omegas if 0 < abs(w) < 1e-9]
+    assert not rounding and omegas[-20:] == [0.0] * 20  # turned, then exactly straight
+    assert sign_changes(np.array(omegas)) <= 1  # the turn's own end may overshoot once
 
 
 def test_an_agv_alone_turns_into_a_one_metre_corridor_and_arrives():

@@ -52,6 +52,10 @@ FACE_FIRST = math.radians(15.0)
 """rad: a node this far off the heading is faced first, turning on the spot (turning while
 driving bends the way: the body-frame velocity turns with the body)."""
 
+FACED = 1e-9
+"""rad: a heading error this small is rounding left by the last period's turn (closing the
+error exactly): chasing it drove ω of ±1e-15 rad/s, flipping sign every tick or two."""
+
 MIN_REACH = 0.1
 """m: the least switch reach (the AGV must be able to get this near a node)."""
 
@@ -173,8 +177,8 @@ def _approach(limits, pose, command, node, cap):
     vx = speed * (dx * c + dy * s) / distance
     vy = speed * (-dx * s + dy * c) / distance
     omega = 0.0
-    if distance > FACE_FROM:
-        error = remainder(math.atan2(dy, dx) - pose[2], math.tau)
+    error = remainder(math.atan2(dy, dx) - pose[2], math.tau)
+    if distance > FACE_FROM and abs(error) > FACED:
         if abs(error) > FACE_FIRST:  # face the node first: brake and turn on the spot
             vx = vy = 0.0
         # turning the body turns a body-frame velocity with it: no faster than half a period
