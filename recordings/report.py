@@ -6,7 +6,8 @@ import csv
 import io
 from dataclasses import asdict, fields
 
-from recordings.analysis import AgvAnalysis, RunAnalysis, compare, json_ready
+from recordings.analysis import AgvAnalysis, RunAnalysis, json_ready
+from recordings.compare import compare
 from recordings.text_table import text_table
 
 TABLE_WIDTH = 100  # columns the default tables fit in (--wide: every column)

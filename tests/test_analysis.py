@@ -16,7 +16,8 @@ from fleet.runtime.inprocess import run_in_process
 from fleet.scenario import load_scenario
 from planner.core.motion import step_pose, world_velocity
 from planner.core.path_metrics import crossing_points
-from recordings.analysis import analyze, compare
+from recordings.analysis import analyze
+from recordings.compare import compare
 from recordings.plots import map_figure, save_plots
 from recordings.reader import open_recording
 from recordings.report import comparison_table, run_table, to_csv, to_json

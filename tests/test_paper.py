@@ -17,7 +17,8 @@ from fleet.paper.plan_sections import PLAN_METRICS
 from fleet.paper.prose import Prose, parts
 from fleet.paper.timing_sweep import TIMING_KEY
 from fleet.scenario import load_scenario
-from recordings.analysis import analyze, percent_change
+from recordings.analysis import analyze
+from recordings.compare import percent_change
 from recordings.plan_metrics import map_plans
 from recordings.reader import open_recording
 from recordings.sweep_stats import describe

@@ -13,7 +13,8 @@ from fleet.paper.prose import Prose
 from fleet.paper.published import FIG11, MOTION, TABLE4
 from fleet.paper.timing_sweep import ALGORITHMS
 from recordings import paper_plots
-from recordings.analysis import RunAnalysis, percent_change
+from recordings.analysis import RunAnalysis
+from recordings.compare import percent_change
 
 TABLE4_HEADER = [
     "algorithm",

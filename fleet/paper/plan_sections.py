@@ -16,7 +16,7 @@ from fleet.paper.measures import spread
 from fleet.paper.prose import Prose
 from fleet.paper.published import TABLE2, TABLE3, PlanTable
 from recordings import paper_plots
-from recordings.analysis import percent_change
+from recordings.compare import percent_change
 from recordings.plan_metrics import MapPlans
 from recordings.sweep_stats import describe
 

@@ -20,7 +20,7 @@ from fleet.sweep.grid import build_grid
 from fleet.sweep.keys import Varied, parse_vary
 from fleet.sweep.runner import SweepProgress, execute_sweep, local_pool
 from planner.core.profiles import PAPER
-from recordings.analysis import percent_change
+from recordings.compare import percent_change
 from recordings.sweep_report import SweepEntry
 from recordings.sweep_stats import MetricStats, describe
 
