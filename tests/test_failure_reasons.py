@@ -43,13 +43,20 @@ def test_an_agv_killed_by_a_signal_fails_at_once_and_one_whose_goal_it_holds_nam
     scenario.write_text(SWAP)
     # a grace far longer than the test may take: only the host's word can fail it in time
     run = subprocess.Popen(
-        [*CLI, "run", str(scenario), "--no-record", "--json", "-q", "--grace", "600"],
+        [*CLI, "run", str(scenario), "--no-record", "--json", "--grace", "600"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
-        text=True,
     )
+    # kill it once the run has started (its first progress line), not while the fleet
+    # comes up: an AGV lost then ends the run before it starts, by design
+    started = b""
+    while b"tick" not in started:
+        chunk = os.read(run.stderr.fileno(), 4096)
+        assert chunk, f"the run ended before it started: {started.decode()}"
+        started += chunk
     os.kill(agv_pid("a"), signal.SIGKILL)
-    out, err = run.communicate(timeout=300)
+    out, rest = run.communicate(timeout=300)
+    out, err = out.decode(), (started + rest).decode()
     assert out, f"the run printed no summary (exit {run.returncode}): {err}"
     agvs = {a["name"]: a for a in json.loads(out)["agvs"]}
     assert (agvs["a"]["status"], agvs["a"]["failure"]) == ("failed", "killed by signal 9")
