@@ -11,7 +11,7 @@ import pytest
 from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.maps.text_maps import parse_text_grid
-from planner.traffic import pibt
+from planner.traffic import lacam, pibt
 from planner.traffic.precedence import Precedence
 from planner.traffic.roadmap import UNREACHABLE, Roadmap
 from planner.traffic.schedule import Schedule, ScheduleError
@@ -117,9 +117,9 @@ def test_full_ring_does_not_rotate():
 
 def test_precedence_releases_in_plan_order():
     plan = Precedence([0, 2])
-    plan.append(0, 1, 1)  # agent 0 enters node 1 at step 1
-    plan.append(1, 1, 2)  # agent 1 follows it onto node 1 at step 2
-    plan.append(0, 3, 2)
+    plan.append(0, 1)  # agent 0 enters node 1 at step 1
+    plan.append(1, 1)  # agent 1 follows it onto node 1 at step 2
+    plan.append(0, 3)
     assert plan.release(1, 4) == (0, 0)  # agent 1 waits for agent 0's visit of node 1
     assert plan.release(0, 4) == (2, None)
     plan.reach(0, 1)
@@ -227,3 +227,54 @@ def test_a_start_off_its_node_is_an_error():
     """A body standing between nodes reaches into a neighbour's room: refused."""
     with pytest.raises(ScheduleError, match="from the nearest roadmap node"):
         Schedule(roadmap_of(RING), [("A", (1.9, 1.5), at((3, 3)))])
+
+
+# a dead-end corridor off a junction with a pocket on either side of it
+DEAD_END = """
+#########
+#######.#
+#.......#
+#######.#
+#######.#
+#########
+"""
+
+
+def test_lacam_reorders_two_agents_in_a_dead_end_where_pibt_loops():
+    """A0 stands at the dead end and must stop short of it, A1 must get behind it: both
+    have to leave the corridor and come back in the other order. PIBT pushes them back
+    and forth for ever; LaCAM finds the way, every step a valid one."""
+    roadmap = roadmap_of(DEAD_END)
+    start = [roadmap.node_at(at((1, 3))), roadmap.node_at(at((4, 3)))]
+    goals = [roadmap.node_at(at((3, 3))), roadmap.node_at(at((2, 3)))]
+    tables = [roadmap.distances(g) for g in goals]
+    config, priorities = list(start), [0.5, 0.25]
+    for k in range(200):
+        config_next = pibt.step(roadmap.neighbours, config, tables, priorities)
+        priorities = pibt.next_priorities(priorities, config_next, goals, [0, 1], k + 1)
+        config = config_next
+        assert config != goals, "PIBT alone solved it: the case no longer shows its loop"
+    configs = lacam.solve(roadmap.neighbours, start, goals, tables)
+    assert configs is not None and configs[-1] == goals
+    for before, after in zip([start, *configs], configs, strict=False):
+        assert len(set(after)) == 2  # no two agents on a node
+        assert not (after[0] == before[1] and after[1] == before[0])  # no swap
+        for a in range(2):
+            assert after[a] == before[a] or after[a] in roadmap.neighbours[before[a]]
+
+
+def test_lacam_says_when_there_is_no_way():
+    """Two agents swapping ends of a corridor with no room to pass: None, not a loop."""
+    roadmap = roadmap_of("#####\n#...#\n#####")
+    start = [roadmap.node_at(at((1, 1))), roadmap.node_at(at((3, 1)))]
+    tables = [roadmap.distances(g) for g in start[::-1]]
+    assert lacam.solve(roadmap.neighbours, start, start[::-1], tables) is None
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_schedule_gets_out_of_a_dead_end_loop_with_delays(seed):
+    """The schedule sees the configuration come back, searches with LaCAM, and both
+    agents arrive, whatever the delays."""
+    pairs = [((1, 3), (3, 3)), ((4, 3), (2, 3))]
+    arrived, schedule = run_discrete(DEAD_END, pairs, seed)
+    assert len(arrived) == 2 and schedule.searches >= 1

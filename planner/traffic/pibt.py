@@ -45,11 +45,36 @@ def step(
     its table of steps to its goal, ``priorities[i]`` its priority; ``fixed`` nodes are
     taken by bodies that never move (no agent is planned onto them); ``directions[i]``
     the direction (index into a node's neighbours) of agent i's last move, -1 none."""
+    nodes = constrained_step(neighbours, current, distances, priorities, fixed, directions)
+    assert nodes is not None  # with no constraint PIBT always finds a step
+    return nodes
+
+
+def constrained_step(
+    neighbours: np.ndarray,
+    current: list[int],
+    distances: list[np.ndarray],
+    priorities: list[float],
+    fixed: frozenset[int] | set[int] = frozenset(),
+    directions: list[int] | None = None,
+    constraints: tuple[tuple[int, int], ...] = (),
+) -> list[int] | None:
+    """``step`` with some agents' next nodes given: ``constraints`` are (agent, node)
+    pairs, placed first; None when they cannot all hold (two on a node, a swap or a
+    rotation, a fixed node) or the others find no step round them. LaCAM's successor
+    generator (``planner.traffic.lacam``)."""
     planner = _Step(neighbours, current, distances, fixed, directions)
+    for i, v in constraints:
+        if v in planner.taken or planner._closes_cycle(i, v):
+            return None
+        planner.to[i], planner.taken[v] = v, i
     for i in sorted(range(len(current)), key=lambda a: (-priorities[a], a)):
         if planner.to[i] is None:
             planner.plan(i, first=True)
-    return [int(v) for v in planner.to]
+    nodes = [int(v) for v in planner.to]
+    if constraints and len(set(nodes)) < len(nodes):
+        return None  # an agent found no node but the one a constraint gave away
+    return nodes
 
 
 def next_priorities(

@@ -22,19 +22,17 @@ from collections import deque
 class Precedence:
     def __init__(self, starts: list[int]):
         self.nodes: list[list[int]] = [[s] for s in starts]  # each agent's plan: nodes
-        self.steps: list[list[int]] = [[0] for _ in starts]  # ... and the step of each
         self.progress = [0] * len(starts)  # the plan entry each agent has reached
         self.released = [0] * len(starts)  # the last plan entry each agent may enter
         self.visits: dict[int, deque[tuple[int, int]]] = {}
         for agent, node in enumerate(starts):
             self.visits.setdefault(node, deque()).append((agent, 0))
 
-    def append(self, agent: int, node: int, step: int) -> None:
-        """Agent enters ``node`` at plan ``step`` (after every step already planned)."""
+    def append(self, agent: int, node: int) -> None:
+        """Agent enters ``node`` at the next plan step (after every step already planned)."""
         if node == self.nodes[agent][-1]:
             return
         self.nodes[agent].append(node)
-        self.steps[agent].append(step)
         self.visits.setdefault(node, deque()).append((agent, len(self.nodes[agent]) - 1))
 
     def reach(self, agent: int, entry: int) -> None:
@@ -68,7 +66,6 @@ class Precedence:
         for entry in range(keep, len(self.nodes[agent])):
             self.visits[self.nodes[agent][entry]].remove((agent, entry))
         del self.nodes[agent][keep:]
-        del self.steps[agent][keep:]
 
     def remove(self, agent: int) -> None:
         """Drop every visit of an agent that stopped for good off its plan (it failed):
@@ -79,7 +76,6 @@ class Precedence:
                 queue.remove((agent, entry))
         self.released[agent] = self.progress[agent]
         del self.nodes[agent][self.progress[agent] + 1 :]
-        del self.steps[agent][self.progress[agent] + 1 :]
 
     def holder(self, node: int) -> int | None:
         """The agent whose visit of ``node`` comes next (None: no visit planned)."""
