@@ -12,6 +12,7 @@ from planner.maps.clearance import Clearance
 from planner.maps.costmap import Costmap
 from planner.maps.text_maps import parse_text_grid
 from planner.traffic import lacam, pibt
+from planner.traffic.loops import LoopWatch
 from planner.traffic.precedence import Precedence
 from planner.traffic.roadmap import UNREACHABLE, Roadmap
 from planner.traffic.schedule import Schedule, ScheduleError
@@ -278,3 +279,24 @@ def test_schedule_gets_out_of_a_dead_end_loop_with_delays(seed):
     pairs = [((1, 3), (3, 3)), ((4, 3), (2, 3))]
     arrived, schedule = run_discrete(DEAD_END, pairs, seed)
     assert len(arrived) == 2 and schedule.searches >= 1
+
+
+def test_loop_watch_names_whom_to_search_for():
+    """A configuration seen before in the same context: everybody; an agent pushed off its
+    goal twice: the agents pushed off theirs; a group searched in vain: not again until
+    the goals or the fixed bodies change."""
+    watch = LoopWatch()
+    moving, goals, fixed = [0, 1, 2], [5, 6, 7], frozenset({9})
+    assert watch.suspects(moving, goals, fixed, [1, 2, 3]) is None
+    assert watch.suspects(moving, goals, fixed, [1, 2, 4]) is None
+    assert watch.suspects(moving, goals, fixed, [1, 2, 3]) == [0, 1, 2]
+    watch.failed(moving)
+    assert watch.suspects(moving, goals, fixed, [1, 2, 3]) is None
+    assert watch.suspects(moving, goals, frozenset(), [1, 2, 3]) is None  # a new context
+    watch.moved(1, 6, 8, 6)
+    watch.moved(2, 7, 3, 7)
+    assert watch.suspects(moving, goals, frozenset(), [1, 8, 3]) is None  # once each
+    watch.moved(1, 6, 8, 6)
+    assert watch.suspects(moving, goals, frozenset(), [1, 8, 4]) == [1, 2]
+    watch.solved([1, 2])
+    assert watch.suspects(moving, goals, frozenset(), [1, 8, 5]) is None

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 from planner.core.errors import BadInputError
 from planner.maps.grid import Point
 from planner.traffic import lacam, pibt
+from planner.traffic.loops import LoopWatch
 from planner.traffic.precedence import Precedence
 from planner.traffic.roadmap import GAP, UNREACHABLE, Roadmap
 
@@ -122,10 +123,8 @@ class Schedule:
         self.done: set[int] = set()  # agents that arrived or failed
         self.waiting: dict[int, int | None] = {}  # whom each agent waited for, last update
         self.events: list[ScheduleEvent] = []
+        self.loops = LoopWatch()
         self.searches = 0  # LaCAM searches made (PIBT pushing agents back and forth)
-        self._context: tuple = ()  # the moving agents, their goals and the fixed nodes
-        self._seen: set[tuple[int, ...]] = set()  # their configurations in that context
-        self._gave_up: tuple | None = None  # the context LaCAM found no way in
         self._freeze_at_goals()
 
     def node_of(self, who: str, point: Point, what: str) -> int:
@@ -155,6 +154,7 @@ class Schedule:
         self.goals[agent] = self.node_of(f"AGV {name!r}", goal, "goal")
         self.goal_points[agent] = tuple(goal)
         self.frozen.discard(agent)
+        self.loops.new_goal(agent)
         self._plan_again()
 
     def fail(self, name: str, position: Point) -> None:
@@ -237,35 +237,47 @@ class Schedule:
         return table[self.config[agent]] >= UNREACHABLE
 
     def _plan_step(self) -> None:
-        """One PIBT step for the agents not frozen; or, when their configuration comes
-        back unchanged in the frozen bodies and goals (PIBT pushing agents back and
-        forth), LaCAM's whole way to their goals from there."""
+        """One PIBT step for the agents not frozen; or, when PIBT is going round a loop
+        (``planner.traffic.loops``), LaCAM's way to their goals for the agents in it."""
         moving = [
             a for a in range(len(self.names)) if a not in self.frozen and a not in self.failed
         ]
         fixed = self._fixed()
         current = [self.config[a] for a in moving]
         goals = [self.goals[a] for a in moving]
+        group = self.loops.suspects(moving, goals, fixed, current)
+        if group is not None and self._search(moving, group, fixed):
+            return
         tables = [self.roadmap.distances(g, fixed) for g in goals]
-        context = (tuple(moving), tuple(goals), fixed)
-        if context != self._context:
-            self._context, self._seen = context, set()
-        if tuple(current) in self._seen and context != self._gave_up:
-            self._seen.clear()
-            self.searches += 1
-            configs = lacam.solve(self.roadmap.neighbours, current, goals, tables, fixed)
-            if configs is not None:
-                for nodes in configs:
-                    self._advance(moving, nodes)
-                self._freeze_at_goals()
-                return
-            self._gave_up = context  # no way within the budget: not again until it changes
-        self._seen.add(tuple(current))
         directions = [self.directions[a] for a in moving]
         priorities = [self.priorities[a] for a in moving]
         nodes = pibt.step(self.roadmap.neighbours, current, tables, priorities, fixed, directions)
         self._advance(moving, nodes)
         self._freeze_at_goals()
+
+    def _search(self, moving: list[int], group: list[int], fixed: frozenset[int]) -> bool:
+        """Plan LaCAM's way to their goals for the agents at ``group`` (positions in
+        ``moving``), the other moving agents standing still; whether it found one."""
+        self.searches += 1
+        agents = [moving[i] for i in group]
+        others = {self.config[a] for a in moving} - {self.config[a] for a in agents}
+        blocked = fixed | others
+        start = [self.config[a] for a in agents]
+        goals = [self.goals[a] for a in agents]
+        tables = [self.roadmap.distances(g, blocked) for g in goals]
+        budget = lacam.BUDGET if len(agents) == len(moving) else lacam.BUDGET // 10
+        configs = lacam.solve(self.roadmap.neighbours, start, goals, tables, blocked, budget)
+        if not configs:
+            self.loops.failed(agents)
+            return False
+        for sub in configs:
+            nodes = [self.config[a] for a in moving]
+            for i, v in zip(group, sub, strict=True):
+                nodes[i] = v
+            self._advance(moving, nodes)
+        self.loops.solved(agents)
+        self._freeze_at_goals()
+        return True
 
     def _advance(self, moving: list[int], nodes: list[int]) -> None:
         """The next plan step: the ``moving`` agents go to ``nodes``."""
@@ -275,6 +287,7 @@ class Schedule:
         for a, node, p in zip(
             moving, nodes, pibt.next_priorities(priorities, nodes, goals, moving, self.step)
         ):
+            self.loops.moved(a, self.config[a], node, self.goals[a])
             if node != self.config[a]:
                 self.directions[a] = list(self.roadmap.neighbours[self.config[a]]).index(node)
             self.config[a], self.priorities[a] = node, p
