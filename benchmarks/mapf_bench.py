@@ -1,6 +1,6 @@
 """MAPF benchmark with vehicle dynamics: MovingAI maps and .scen files, first N agents.
 
-``python benchmarks/mapf_bench.py [--data DIR] [--suite warehouse|room|all] [--agents 10,25]
+``python benchmarks/mapf_bench.py [--data DIR] [--suite warehouse|room|random|all] [--agents 10,25]
 [--scens 6,7] [--traffic reservations] [--zenoh K] [--time-limit S] [--json]``
 (from the repository root) runs, in process, each instance: the map at 1 m cells, AGVs of
 radius 0.3 m at 1 m/s, 0.5 m/s², 60 °/s, starts and goals the first N rows of the
@@ -47,8 +47,10 @@ DATA = Path("/work/shared/data/mapf")
 SUITES = {
     "warehouse": ("warehouse-10-20-10-2-1", [f"random-{i}" for i in (6, 7, 8, 9, 10)]),
     "room": ("room-32-32-4", [f"random-{i}" for i in (6, 7, 8, 9, 10)]),
+    # open floor with 10 % random obstacles: the LaCAM README's worked example
+    "random": ("random-32-32-10", ["random-1"]),
 }
-DEFAULT_AGENTS = {"warehouse": (10, 25, 50, 100), "room": (10, 25)}
+DEFAULT_AGENTS = {"warehouse": (10, 25, 50, 100), "room": (10, 25), "random": (10, 25, 50, 100)}
 SOLO_CACHE = ROOT / "runs" / "mapf_solo.json"
 FLOWTIME_TARGET = {50: 1.3, 100: 1.6}
 CPU_TARGET_MS = 1.0
@@ -193,8 +195,9 @@ def main(argv=None) -> int:
     p.add_argument("--suite", choices=(*SUITES, "all"), default="all")
     p.add_argument("--agents", help="comma-separated N (default: 10,25,50,100 / room 10,25)")
     p.add_argument(
-        "--scens", default="6,7,8,9,10",
-        help="which .scen files: K for random-K, or a full suffix such as even-7",
+        "--scens",
+        help="which .scen files: K for random-K, or a full suffix such as even-7 (default: "
+        "random-6..10 of warehouse and room, random-1 of random)",
     )  # fmt: skip
     p.add_argument("--traffic", default="reservations", choices=("reservations", "zones"))
     p.add_argument("--time-limit", type=float, default=900.0)
@@ -220,7 +223,7 @@ def main(argv=None) -> int:
 def _bench(args) -> int:
     if args.kill_9:
         map_name = SUITES["warehouse"][0]
-        scen = _scen_path(args.data, map_name, args.scens.split(",")[0])
+        scen = _scen_path(args.data, map_name, (args.scens or "6").split(",")[0])
         if not scen.is_file():
             raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")
         scenario = scenario_for(args.data / f"{map_name}.map", scen, args.kill_9, args.time_limit)
@@ -234,7 +237,7 @@ def _bench(args) -> int:
         if not map_path.is_file():
             raise AgvFleetError(f"no {map_path}: give the MovingAI MAPF files with --data DIR")
         agents = [int(n) for n in args.agents.split(",")] if args.agents else DEFAULT_AGENTS[suite]
-        for k in args.scens.split(","):
+        for k in args.scens.split(",") if args.scens else SUITES[suite][1]:
             scen = _scen_path(args.data, map_name, k)
             if not scen.is_file():
                 raise AgvFleetError(f"no {scen}: give the MovingAI MAPF files with --data DIR")

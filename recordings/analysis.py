@@ -29,7 +29,9 @@ Definitions (all from ``recordings.series``, i.e. the world's ticks):
   first; the run's traffic events, every ``wait``, ``go`` and ``yield`` event.
   Traffic mode "reservations": ``reservations``, the ``reserved`` events (nodes released
   to an AGV by the schedule); ``reservation_waits``, the ``waits-for`` events (an AGV
-  waits for another to leave the node it needs next), also counted in each AGV's waits.
+  waits for another to leave the node it needs next), also counted in each AGV's waits;
+  ``reservation_searches``, the ``searched`` events (LaCAM planned a way out of a loop
+  of PIBT's).
 """
 
 from __future__ import annotations
@@ -45,7 +47,7 @@ from planner.core.motion import world_velocity
 from planner.core.status import ARRIVED, COLLISION, FINISHED, RECOVERY, REPLAN, WAITING
 from planner.maps.distance_field import DistanceField
 from planner.nav.fusion import GLOBAL_ALGORITHM
-from planner.traffic.schedule import RESERVED, WAITS_FOR
+from planner.traffic.schedule import RESERVED, SEARCHED, WAITS_FOR
 from planner.traffic.zones import DECISIONS, WAIT
 from recordings.reader import Recording
 from recordings.series import RunSeries, extract
@@ -117,6 +119,7 @@ class RunAnalysis:
     traffic_events: int = 0  # wait, go and yield events
     reservations: int = 0  # "reserved" events (traffic mode "reservations")
     reservation_waits: int = 0  # "waits-for" events
+    reservation_searches: int = 0  # "searched" events: LaCAM out of a loop of PIBT's
     self_crossings: int = 0  # summed over AGVs
     recoveries: int = 0  # summed over AGVs
     tasks: dict | None = None  # a shift's throughput (recordings.task_stats), else None
@@ -211,6 +214,7 @@ def analyze(rec: Recording, series: RunSeries | None = None) -> RunAnalysis:
         traffic_events=len(traffic),
         reservations=sum(e.get("kind") == RESERVED for e in series.events),
         reservation_waits=len(waits_for),
+        reservation_searches=sum(e.get("kind") == SEARCHED for e in series.events),
         self_crossings=sum(a.self_crossings for a in agvs),
         recoveries=sum(a.recoveries for a in agvs),
         tasks=None if shift is None else shift[0],
@@ -422,6 +426,7 @@ COMPARED = (
     ("traffic_events", "traffic events", ""),
     ("reservations", "node reservations", ""),
     ("reservation_waits", "waits for a reserved node", ""),
+    ("reservation_searches", "searches out of a loop", ""),
     ("recoveries", "recoveries", ""),
     ("plan_time_mean_ms", "plan time mean", "ms"),
     ("plan_time_p95_ms", "plan time p95", "ms"),

@@ -168,3 +168,31 @@ def test_kill_9_inside_an_aisle_the_others_arrive_or_name_the_dead_agv(tmp_path)
         agv = by_name[name]
         assert agv["status"] == "arrived" or victim in agv["failure"], agv
     assert summary["collisions"] == 0
+
+
+def test_two_agvs_reorder_in_a_dead_end_recorded_with_the_search(tmp_path):
+    """The dead end of tests/test_reservations.py driven by vehicles: PIBT alone pushes
+    them back and forth for ever; the schedule's LaCAM search gets both in, and the
+    recording has the ``searched`` event that ``analyze`` counts."""
+    from tests.test_reservations import DEAD_END
+
+    lines = [
+        'name = "dead-end"',
+        "time_limit = 300.0",
+        '[traffic]\nmode = "reservations"',
+        "[map]\nresolution = 1.0",
+        f'grid = """{DEAD_END.strip()}"""',
+        "[agv_defaults]",
+        "radius = 0.3\nmax_speed = 1.0\nmax_accel = 0.5\nmax_omega = 60.0",
+        '[[agvs]]\nname = "A0"\nstart = [1.5, 3.5]\ngoal = [3.5, 3.5]',
+        '[[agvs]]\nname = "A1"\nstart = [4.5, 3.5]\ngoal = [2.5, 3.5]',
+    ]
+    mcap = tmp_path / "dead-end.mcap"
+    summary = run_recorded(parse_scenario("\n".join(lines) + "\n"), mcap, {})
+    assert summary.success, summary.table()
+    recording = open_recording(mcap)
+    analysis = analyze(recording)
+    assert analysis.collisions == 0 and analysis.arrived == 2
+    searched = [m.data for m in recording.of("world/event") if m.data["kind"] == "searched"]
+    assert searched and analysis.reservation_searches == len(searched)
+    assert "LaCAM found a way" in searched[0]["detail"]

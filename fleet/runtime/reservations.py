@@ -4,7 +4,8 @@ Why the world and not every AGV: see ``planner.traffic.schedule``. The world upd
 the schedule once per tick from the states it integrated, hands every running AGV its
 reservation with the tick, and records the schedule's decisions as events
 (``reserved``: nodes released to an AGV; ``waits-for``: an AGV waits for another to
-leave the node it needs next). Both run modes run this same code in the world.
+leave the node it needs next; ``searched``: LaCAM planned a way out of a loop of PIBT's).
+Both run modes run this same code in the world.
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ from planner.traffic.roadmap import UNREACHABLE
 
 BUDGET = 200_000
 """Agent moves generated at most per search (each successor costs one per agent): about
-a second of Python; a search that needs more gives up and PIBT goes on."""
+1.5 s of CPU; a search that needs more gives up and PIBT goes on."""
 
 
 @dataclass(eq=False)

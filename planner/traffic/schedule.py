@@ -75,13 +75,13 @@ class Reservation:
 
 @dataclass
 class ScheduleEvent:
-    kind: str  # "reserved" or "waits-for"
+    kind: str  # "reserved", "waits-for" or "searched"
     agvs: list[str]
     detail: str
 
 
-RESERVED, WAITS_FOR = "reserved", "waits-for"
-EVENT_KINDS = (RESERVED, WAITS_FOR)
+RESERVED, WAITS_FOR, SEARCHED = "reserved", "waits-for", "searched"
+EVENT_KINDS = (RESERVED, WAITS_FOR, SEARCHED)
 
 
 class Schedule:
@@ -267,6 +267,10 @@ class Schedule:
         tables = [self.roadmap.distances(g, blocked) for g in goals]
         budget = lacam.BUDGET if len(agents) == len(moving) else lacam.BUDGET // 10
         configs = lacam.solve(self.roadmap.neighbours, start, goals, tables, blocked, budget)
+        names = [self.names[a] for a in agents]
+        found = f"a way of {len(configs)} steps" if configs else "no way within its budget"
+        note = f"PIBT went round a loop; LaCAM found {found} for {', '.join(names)}"
+        self.events.append(ScheduleEvent(SEARCHED, names, note))
         if not configs:
             self.loops.failed(agents)
             return False
