@@ -18,6 +18,7 @@ from __future__ import annotations
 import json
 import queue
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import msgspec
@@ -27,7 +28,7 @@ from bridge import keys
 from bridge.log import say
 from bridge.messages import MessageError, from_dict
 from bridge.session import MAX_MESSAGE_BYTES
-from bridge.struct_decoder import decode_valid
+from bridge.struct_decoder import decode_struct, to_message
 from bridge.wire import is_binary, to_wire
 
 MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
@@ -36,21 +37,29 @@ MAX_COUNTED_KEYS = 1000
 OTHER_KEYS = "(other keys)"
 
 
-def decode(key: str, payload: bytes):
-    """The message a relative key carries, decoded and validated (MessageError if not)."""
+def decode(key: str, payload: bytes, drop: Callable[[object], bool] | None = None):
+    """The message a relative key carries, decoded and validated (MessageError if not).
+
+    ``drop``: a look at the validated message before it is made (its Struct: the same
+    field names), True for one the reader does not want: then None, and the copy into the
+    dataclass is saved. Every check is made first, whatever ``drop`` says."""
     cls = keys.message_type(key)
     if cls is None:
         raise MessageError("no message type for this key")
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
     binary = is_binary(key)
-    msg = decode_valid(cls, payload, binary)
-    if msg is None:  # refused by the fast path: the reference decoder decides, and says why
+    msg = struct = decode_struct(cls, payload, binary)
+    if struct is None:  # refused by the fast path: the reference decoder decides, and says why
         msg = _reference_decode(cls, payload, binary)
     owner = keys.agv_name(key)
     if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
-    return msg
+    if struct is None:
+        return msg
+    if drop is not None and drop(struct):
+        return None
+    return to_message(cls, struct)
 
 
 def _reference_decode(cls, payload: bytes, binary: bool = False):
@@ -109,20 +118,27 @@ class Bus:
             self._publishers[key] = pub
         pub.put(payload)
 
-    def subscribe(self, key_expr: str) -> queue.SimpleQueue:
+    def subscribe(
+        self, key_expr: str, drop: Callable[[object], bool] | None = None
+    ) -> queue.SimpleQueue:
         """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
-        (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``)."""
+        (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``).
+
+        ``drop`` (see ``decode``) runs in Zenoh's receiving thread on every valid message:
+        one it drops never reaches the queue, and the thread waiting on the queue is not
+        woken for it (an AGV held at its goal skips the ticks it would not answer)."""
         q: queue.SimpleQueue = queue.SimpleQueue()
 
         def on_sample(sample: zenoh.Sample) -> None:
             key = self.relative(sample.key_expr)
             payload = sample.payload.to_bytes()
             try:
-                msg = decode(key, payload)
+                msg = decode(key, payload, drop)
             except MessageError as err:
                 self.count_invalid(key, err)
                 return
-            q.put(Received(key, msg, payload))
+            if msg is not None:
+                q.put(Received(key, msg, payload))
 
         self._keep.append(self.session.declare_subscriber(self.full(key_expr), on_sample))
         return q
