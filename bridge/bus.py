@@ -10,7 +10,10 @@ per key (to the node's stderr); the node goes on. Subscribers deliver into a que
 node can wait with a timeout (``recv()`` of zenoh handlers has none): a
 ``queue.SimpleQueue``, in C: ``queue.Queue``'s Python locks cost 50 AGV processes, whose
 caches are cold at every tick, 4 to 6 ms of CPU per tick in their main threads and 2.5 ms
-in their receiving threads (of about 65 and 15).
+in their receiving threads (of about 65 and 15). ``listen`` instead calls a function
+with each message as it arrives (an AGV answers its tick there, in Zenoh's network
+thread: one thread woken per tick, not three), and a reader may ``drop`` a message after
+a look at its validated fields, before it is made into a dataclass.
 """
 
 from __future__ import annotations
@@ -83,6 +86,15 @@ def _reference_decode(cls, payload: bytes, binary: bool = False):
     return from_dict(cls, data)
 
 
+def _direct(callback):
+    """``callback`` as a handler zenoh-python calls in its network thread (``indirect``,
+    unstable in zenoh-python 1.x; a version without it calls it in its own thread)."""
+    try:
+        return zenoh.handlers.Callback(callback, indirect=False)
+    except (AttributeError, TypeError):
+        return callback
+
+
 @dataclass
 class Received:
     key: str  # relative to the run prefix
@@ -119,7 +131,7 @@ class Bus:
         pub.put(payload)
 
     def subscribe(
-        self, key_expr: str, drop: Callable[[object], bool] | None = None
+        self, key_expr: str, drop: Callable[[object], bool] | None = None, *, direct: bool = False
     ) -> queue.SimpleQueue:
         """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
         (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``).
@@ -128,6 +140,25 @@ class Bus:
         one it drops never reaches the queue, and the thread waiting on the queue is not
         woken for it (an AGV held at its goal skips the ticks it would not answer)."""
         q: queue.SimpleQueue = queue.SimpleQueue()
+        self.listen(key_expr, q.put, drop, direct=direct)
+        return q
+
+    def listen(
+        self,
+        key_expr: str,
+        deliver: Callable[[Received], None],
+        drop: Callable[[object], bool] | None = None,
+        *,
+        direct: bool = False,
+    ) -> None:
+        """``deliver(Received)`` for every valid message on ``<prefix>/<key_expr>`` as it
+        arrives (``subscribe`` delivers into a queue); ``drop`` as for ``subscribe``.
+
+        zenoh-python calls a callback in a Python thread of its own, which its network
+        thread wakes for each message: ``direct`` calls it in the network thread itself,
+        one thread woken per message instead of two, for a process that does nothing else
+        meanwhile (an AGV answering its ticks). Not for a router's session: while the
+        callback waits for the GIL, that network thread forwards nobody's messages."""
 
         def on_sample(sample: zenoh.Sample) -> None:
             key = self.relative(sample.key_expr)
@@ -138,10 +169,10 @@ class Bus:
                 self.count_invalid(key, err)
                 return
             if msg is not None:
-                q.put(Received(key, msg, payload))
+                deliver(Received(key, msg, payload))
 
-        self._keep.append(self.session.declare_subscriber(self.full(key_expr), on_sample))
-        return q
+        handler = _direct(on_sample) if direct else on_sample
+        self._keep.append(self.session.declare_subscriber(self.full(key_expr), handler))
 
     def count_invalid(self, key: str, why) -> None:
         """Count a message that was not used (a node's own checks call this too)."""
