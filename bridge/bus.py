@@ -10,7 +10,10 @@ per key (to the node's stderr); the node goes on. Subscribers deliver into a que
 node can wait with a timeout (``recv()`` of zenoh handlers has none): a
 ``queue.SimpleQueue``, in C: ``queue.Queue``'s Python locks cost 50 AGV processes, whose
 caches are cold at every tick, 4 to 6 ms of CPU per tick in their main threads and 2.5 ms
-in their receiving threads (of about 65 and 15).
+in their receiving threads (of about 65 and 15). ``listen`` instead calls a function
+with each message as it arrives (an AGV answers its tick there, in Zenoh's network
+thread: one thread woken per tick, not three), and a reader may ``drop`` a message after
+a look at its validated fields, before it is made into a dataclass.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from __future__ import annotations
 import json
 import queue
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import msgspec
@@ -27,7 +31,7 @@ from bridge import keys
 from bridge.log import say
 from bridge.messages import MessageError, from_dict
 from bridge.session import MAX_MESSAGE_BYTES
-from bridge.struct_decoder import decode_valid
+from bridge.struct_decoder import decode_struct, to_message
 from bridge.wire import is_binary, to_wire
 
 MAX_PAYLOAD_BYTES = MAX_MESSAGE_BYTES
@@ -36,21 +40,29 @@ MAX_COUNTED_KEYS = 1000
 OTHER_KEYS = "(other keys)"
 
 
-def decode(key: str, payload: bytes):
-    """The message a relative key carries, decoded and validated (MessageError if not)."""
+def decode(key: str, payload: bytes, drop: Callable[[object], bool] | None = None):
+    """The message a relative key carries, decoded and validated (MessageError if not).
+
+    ``drop``: a look at the validated message before it is made (its Struct: the same
+    field names), True for one the reader does not want: then None, and the copy into the
+    dataclass is saved. Every check is made first, whatever ``drop`` says."""
     cls = keys.message_type(key)
     if cls is None:
         raise MessageError("no message type for this key")
     if len(payload) > MAX_PAYLOAD_BYTES:
         raise MessageError(f"{len(payload)} bytes, more than {MAX_PAYLOAD_BYTES}")
     binary = is_binary(key)
-    msg = decode_valid(cls, payload, binary)
-    if msg is None:  # refused by the fast path: the reference decoder decides, and says why
+    msg = struct = decode_struct(cls, payload, binary)
+    if struct is None:  # refused by the fast path: the reference decoder decides, and says why
         msg = _reference_decode(cls, payload, binary)
     owner = keys.agv_name(key)
     if owner is not None and getattr(msg, "name", owner) != owner:  # a type may name none
         raise MessageError(f"names AGV {msg.name!r}"[:200])
-    return msg
+    if struct is None:
+        return msg
+    if drop is not None and drop(struct):
+        return None
+    return to_message(cls, struct)
 
 
 def _reference_decode(cls, payload: bytes, binary: bool = False):
@@ -72,6 +84,15 @@ def _reference_decode(cls, payload: bytes, binary: bool = False):
     except RecursionError:
         raise MessageError("JSON nested too deeply") from None
     return from_dict(cls, data)
+
+
+def _direct(callback):
+    """``callback`` as a handler zenoh-python calls in its network thread (``indirect``,
+    unstable in zenoh-python 1.x; a version without it calls it in its own thread)."""
+    try:
+        return zenoh.handlers.Callback(callback, indirect=False)
+    except (AttributeError, TypeError):
+        return callback
 
 
 @dataclass
@@ -109,23 +130,49 @@ class Bus:
             self._publishers[key] = pub
         pub.put(payload)
 
-    def subscribe(self, key_expr: str) -> queue.SimpleQueue:
+    def subscribe(
+        self, key_expr: str, drop: Callable[[object], bool] | None = None, *, direct: bool = False
+    ) -> queue.SimpleQueue:
         """A queue of ``Received`` for every valid message on ``<prefix>/<key_expr>``
-        (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``)."""
+        (with its payload as it came, which the recorder stores, as JSON: ``bridge.wire``).
+
+        ``drop`` (see ``decode``) runs in Zenoh's receiving thread on every valid message:
+        one it drops never reaches the queue, and the thread waiting on the queue is not
+        woken for it (an AGV held at its goal skips the ticks it would not answer)."""
         q: queue.SimpleQueue = queue.SimpleQueue()
+        self.listen(key_expr, q.put, drop, direct=direct)
+        return q
+
+    def listen(
+        self,
+        key_expr: str,
+        deliver: Callable[[Received], None],
+        drop: Callable[[object], bool] | None = None,
+        *,
+        direct: bool = False,
+    ) -> None:
+        """``deliver(Received)`` for every valid message on ``<prefix>/<key_expr>`` as it
+        arrives (``subscribe`` delivers into a queue); ``drop`` as for ``subscribe``.
+
+        zenoh-python calls a callback in a Python thread of its own, which its network
+        thread wakes for each message: ``direct`` calls it in the network thread itself,
+        one thread woken per message instead of two, for a process that does nothing else
+        meanwhile (an AGV answering its ticks). Not for a router's session: while the
+        callback waits for the GIL, that network thread forwards nobody's messages."""
 
         def on_sample(sample: zenoh.Sample) -> None:
             key = self.relative(sample.key_expr)
             payload = sample.payload.to_bytes()
             try:
-                msg = decode(key, payload)
+                msg = decode(key, payload, drop)
             except MessageError as err:
                 self.count_invalid(key, err)
                 return
-            q.put(Received(key, msg, payload))
+            if msg is not None:
+                deliver(Received(key, msg, payload))
 
-        self._keep.append(self.session.declare_subscriber(self.full(key_expr), on_sample))
-        return q
+        handler = _direct(on_sample) if direct else on_sample
+        self._keep.append(self.session.declare_subscriber(self.full(key_expr), handler))
 
     def count_invalid(self, key: str, why) -> None:
         """Count a message that was not used (a node's own checks call this too)."""
