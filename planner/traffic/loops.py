@@ -53,9 +53,7 @@ class LoopWatch:
             return list(range(len(moving)))
         self._seen.add(config)
         if any(self._leaves[a] >= LEAVES or self._stalls[a] >= STALL for a in moving):
-            group = [
-                i for i, a in enumerate(moving) if self._leaves[a] or self._stalls[a] >= STALL
-            ]
+            group = [i for i, a in enumerate(moving) if self._leaves[a] or self._stalls[a] >= STALL]
             if frozenset(moving[i] for i in group) not in self._failed:
                 return group
         return None
