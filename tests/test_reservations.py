@@ -250,9 +250,9 @@ def test_lacam_reorders_two_agents_in_a_dead_end_where_pibt_loops():
     goals = [roadmap.node_at(at((3, 3))), roadmap.node_at(at((2, 3)))]
     tables = [roadmap.distances(g) for g in goals]
     config, priorities = list(start), [0.5, 0.25]
-    for k in range(200):
+    for _ in range(200):
         config_next = pibt.step(roadmap.neighbours, config, tables, priorities)
-        priorities = pibt.next_priorities(priorities, config_next, goals, [0, 1], k + 1)
+        priorities = pibt.next_priorities(priorities, config_next, goals, [0, 1])
         config = config_next
         assert config != goals, "PIBT alone solved it: the case no longer shows its loop"
     configs = lacam.solve(roadmap.neighbours, start, goals, tables)

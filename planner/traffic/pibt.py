@@ -19,8 +19,8 @@ broken by going on straight, for an agent not pushed by another (a vehicle stops
 turn: with the hash alone the many shortest ways across an open floor became
 staircases, a turn at every node; for pushed agents too, two agents swapping through
 a corridor with a side pocket pushed each other back and forth for ever), then by a
-fixed hash of agent and node; ties between agents by a hash of agent and step
-(``next_priorities``), then their index.
+fixed hash of agent and node; ties between agents by a fixed hash of the agent (its
+tie-break, ``next_priorities``), then their index.
 """
 
 from __future__ import annotations
@@ -78,25 +78,24 @@ def constrained_step(
 
 
 def next_priorities(
-    priorities: list[float], nodes: list[int], goals: list[int], agents: list[int], step: int
+    priorities: list[float], nodes: list[int], goals: list[int], agents: list[int]
 ) -> list[float]:
-    """PIBT's priorities after ``step``: +1 away from the goal, only the tie-break at it.
-    The tie-break (below one) is drawn again each step from a fixed hash of agent and
-    step: with a fixed one, of two agents kept from their goals equally long the same
-    one always went first, and two that met in a corridor with a side pocket pushed
-    each other back and forth for ever."""
+    """PIBT's priorities after a step: +1 away from the goal, only the tie-break at it.
+    The tie-break (below one) is fixed per agent, as in PIBT: of two agents kept from
+    their goals equally long the same one goes first every step. It was once drawn again
+    every 10 steps, against two agents in a corridor with a side pocket that pushed each
+    other back and forth for ever; but then two agents meeting head-on in a long corridor
+    swapped who pushed whom every 10 steps, and LaCAM (``planner.traffic.lacam``) now
+    gets the pocket case out of its loop (warehouse even-10, 50 AGVs: flowtime 1.35 ->
+    1.17)."""
     return [
-        (0.0 if node == goal else math.floor(p) + 1.0) + _tie_break(agent, step)
+        (0.0 if node == goal else math.floor(p) + 1.0) + _tie_break(agent)
         for p, node, goal, agent in zip(priorities, nodes, goals, agents, strict=True)
     ]
 
 
-EPOCH = 10
-
-
-def _tie_break(agent: int, step: int) -> float:
-    step //= EPOCH
-    return ((agent * _HASH) ^ (step * 40503 + 0x9E3779B9)) % 2**32 * _HASH % 2**32 / 2**32
+def _tie_break(agent: int) -> float:
+    return ((agent * _HASH) ^ 0x9E3779B9) % 2**32 * _HASH % 2**32 / 2**32
 
 
 class _Step:

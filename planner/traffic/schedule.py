@@ -112,8 +112,7 @@ class Schedule:
                     )
                 seen[node] = name
         self.plan = Precedence(starts)
-        self.config = list(starts)  # every agent's node at plan step ``self.step``
-        self.step = 0
+        self.config = list(starts)  # every agent's node at the last plan step
         # PIBT's first priorities: the trip length as a fraction (longer trips first)
         trips = [int(roadmap.distances(g)[s]) for s, g in zip(starts, self.goals, strict=True)]
         self.priorities = [t / max(1, len(roadmap)) if t < UNREACHABLE else 0.0 for t in trips]
@@ -287,9 +286,8 @@ class Schedule:
         """The next plan step: the ``moving`` agents go to ``nodes``."""
         priorities = [self.priorities[a] for a in moving]
         goals = [self.goals[a] for a in moving]
-        self.step += 1
         for a, node, p in zip(
-            moving, nodes, pibt.next_priorities(priorities, nodes, goals, moving, self.step)
+            moving, nodes, pibt.next_priorities(priorities, nodes, goals, moving)
         ):
             self.loops.moved(a, self.config[a], node, self.goals[a])
             if node != self.config[a]:
