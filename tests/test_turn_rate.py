@@ -13,12 +13,16 @@ import math
 import numpy as np
 import pytest
 
+from bridge import keys
+from fleet.runtime.inprocess import run_in_process
+from fleet.scenario import load_scenario, with_profile
 from planner.core.motion import step_pose
+from planner.core.status import ARRIVED, FINISHED
 from planner.local.choice import jerk
 from planner.local.config import DwaConfig
 from planner.local.turning import stopping_rate, turn_command
 from planner.nav.tight_turns import approach_command
-from recordings.analysis import sign_changes
+from recordings.analysis import angular_rms, sign_changes
 
 DEG = math.pi / 180
 TABLE1 = DwaConfig()
@@ -83,3 +87,25 @@ def test_the_straight_approach_after_a_turn_on_the_spot_does_not_turn_back():
                 pose = step_pose(pose, command, config.dt)
                 omegas.append(command[2])
             assert sign_changes(np.array(omegas)) == 0, (config.max_omega, bearing)
+
+
+def _omegas(profile: str) -> tuple[np.ndarray, object, float]:
+    """The turn rate over the drive of paper-dynamic's AGV with ``profile``, its summary
+    and the control period."""
+    states = []
+    scenario = with_profile(load_scenario("paper-dynamic"), profile)
+    summary = run_in_process(
+        scenario, lambda key, msg: states.extend(msg.agvs) if key == keys.WORLD_TICK else None
+    )
+    end = next((i for i, s in enumerate(states) if s.status in FINISHED), len(states))
+    return np.array([s.omega for s in states[: end + 1]]), summary.agvs[0], scenario.dt
+
+
+def test_on_paper_dynamic_the_default_turns_no_more_back_and_forth_than_the_paper():
+    # issue #41: 23 omega sign changes (RMS angular jerk 1.91 rad/s^3) in the default
+    # profile against the paper's 14 (3.25)
+    default, agv, dt = _omegas("default")
+    paper, _, _ = _omegas("paper")
+    assert agv.status == ARRIVED and agv.collisions == 0
+    assert sign_changes(default) <= sign_changes(paper)
+    assert angular_rms(default, dt)[1] <= angular_rms(paper, dt)[1]
