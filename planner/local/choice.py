@@ -79,16 +79,11 @@ def jerk(commands, command, previous, speed):
 
     Linear axes: |(sample - command) - (command - previous)|; omega adds the same change
     times the current ``speed`` (|(vx, vy)| of ``command``), since a turn rate change of
-    dw changes the world-frame velocity by speed x dw. A turn easing out is kept easing
-    out only down to omega = 0, not on through it into the opposite turn: kept through
-    zero, every turn's end became the start of one the other way (the ramps of most of
-    the default's omega sign changes, nav_bench and paper-dynamic alike).
+    dw changes the world-frame velocity by speed x dw.
     """
     keep_x = 2.0 * command[0] - previous[0]
     keep_y = 2.0 * command[1] - previous[1]
     keep_w = 2.0 * command[2] - previous[2]
-    if keep_w * command[2] < 0.0 or command[2] == 0.0:
-        keep_w = 0.0  # a turn's end is where omega stops, not where the next turn starts
     out = np.empty(len(commands))
     for i in range(len(commands)):
         linear = np.hypot(commands[i, 0] - keep_x, commands[i, 1] - keep_y)
