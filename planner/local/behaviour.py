@@ -74,7 +74,7 @@ DEFAULT_BEHAVIOUR = LocalBehaviour(
         *EQ_10,
         Facing(weight=0.3),  # the body faces its travel: sensors and narrow side ahead
         OnRoute(weight=0.3),  # lined up with a narrow passage before it gets there
-        SteadyTurn(weight=0.01),  # omega follows the route's turns, not either side of them
+        SteadyTurn(weight=0.015),  # omega follows the route's turns, not either side of them
     ),
     filters=(
         Admissible(),  # Eq. (7), with the lane's braking room along the route
