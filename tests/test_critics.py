@@ -141,7 +141,7 @@ def test_eq_10s_weights_are_the_vehicles_the_profiles_own_critics_carry_theirs()
     cfg = DwaConfig(alpha=0.4, beta=0.5, gamma=0.6)
     assert [c.weight_in(cfg) for c in PAPER_BEHAVIOUR.critics] == [0.4, 0.5, 0.6]
     own = {c.name: c.weight_in(cfg) for c in DEFAULT_BEHAVIOUR.critics[3:]}
-    assert own == {"facing": 0.3, "on_route": 0.3, "steady_turn": 0.015}
+    assert own == {"facing": 0.3, "on_route": 0.3}
 
 
 # the choice ------------------------------------------------------------------------------
