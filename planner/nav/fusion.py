@@ -273,7 +273,9 @@ class FusionController:
         if final and self.behaviour.tight_turns:  # the goal too: faced, then driven to straight
             straight = self._straight_to(pose, command, target, moving, walkers)
         # plan locally and command
-        turn = self.turn_round.command(self.dwa, pose, command, target, moving)
+        turn = None
+        if not self._stopping_at(position, straight, final):
+            turn = self.turn_round.command(self.dwa, pose, command, target, moving)
         if turn is not None:
             return _step(turn, DRIVING, target, plan=plan)
         if straight is not None:  # the last metres to a tight corner or the goal, straight
@@ -385,6 +387,15 @@ class FusionController:
             cmd = braking_command(self.config.dwa, command)
         self.progress.excuse(now)  # turning on the spot is progress for the progress checker
         return _step(cmd, DRIVING, first)
+
+    def _stopping_at(self, position: Point, straight, final: bool) -> bool:
+        """Whether the straight approach brakes within a tight corner's reach, to stop and
+        turn to the next stretch there: a centimetre past the node, turning round to it
+        first turned the body away from the next stretch (an omega sign change)."""
+        if straight is None or final:
+            return False
+        reach = self.corners[self.key_nodes.index].reach
+        return math.dist(position, self.key_nodes.current) <= reach
 
     def _segment(self, pose, target: Point, moving, walkers):
         segment = (self.key_nodes.segment_start(), target)

@@ -31,6 +31,7 @@ from planner.core.cpython_math import hypot, remainder
 from planner.core.motion import Command, Pose, step_pose
 from planner.core.path_metrics import turn_angle
 from planner.local.config import DwaConfig
+from planner.local.turning import stopping_rate
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import Point
 from planner.nav.recovery import step_towards
@@ -185,10 +186,11 @@ def _approach(limits, pose, command, node, cap):
         # of acceleration can make up for, so that the way stays straight
         moving = hypot(command[0], command[1])
         fastest = min(max_omega, max_accel / (2.0 * moving) if moving else math.inf)
-        # on the braking curve, and no faster than closes the error in one period: the
-        # curve alone overshoots a small error within a period, and omega flipped sign
-        # every tick on straight approaches (+-0.1 rad/s on the depot, at 60 deg/s limits)
-        turn = min(math.sqrt(2.0 * max_alpha * abs(error)), abs(error) / dt)
+        # on the braking curve of whole periods, and no faster than closes the error in
+        # one period: the continuous curve alone overshoots a small error within a period,
+        # and omega flipped sign every tick on straight approaches (+-0.1 rad/s on the
+        # depot, at 60 deg/s limits)
+        turn = stopping_rate(abs(error), dw, dt)
         omega = math.copysign(min(fastest, turn), error)
     # the linear change scaled as a whole (not clipped per axis), so that the velocity turns
     # towards the node's direction along a straight line instead of bending round it
