@@ -18,7 +18,6 @@ from planner.local.critics.facing import Facing
 from planner.local.critics.heading import Heading
 from planner.local.critics.route import OnRoute
 from planner.local.critics.speed import Speed
-from planner.local.critics.turn_rate import SteadyTurn
 from planner.local.cycle import Cycle
 from planner.local.dwa import DwaPlanner
 from planner.local.fallback import Brake, Evade
@@ -108,33 +107,6 @@ def test_on_route_scores_the_cap_less_the_offset_and_needs_a_segment():
     on_segment = cycle(segment=((10.0, 10.0), (15.0, 10.0)))
     np.testing.assert_allclose(OnRoute(0.3).score(candidates(s), on_segment), [2.0, 1.5, 0.0])
     assert OnRoute(0.3).applies(on_segment) and not OnRoute(0.3).applies(cycle())
-
-
-def test_steady_turn_scores_how_little_a_sample_changes_the_turn_rate():
-    dw = CFG.max_alpha * CFG.dt  # 5 deg/s
-    deg = math.pi / 180
-    s = samples([(0.3, 0.0, w * deg) for w in (-4, 0, 2, 3, 7)], [(11.0, 10.0, 0.0)] * 5)
-    turning = cycle(command=(0.3, 0.0, 2 * deg))
-    expected = [0.0, dw - 2 * deg, dw, dw - 1 * deg, 0.0]  # at least 0
-    np.testing.assert_allclose(SteadyTurn(0.01).score(candidates(s), turning), expected)
-
-
-def test_of_two_equal_samples_either_side_the_default_keeps_the_turn_under_way():
-    # the target dead ahead: turning 2 deg/s left or right scores the same by Eq. (10) and
-    # facing; turning left at 1 deg/s, the default's choice goes on left (without the
-    # steady turn the first of the equals, right: the swing from side to side)
-    deg = math.pi / 180
-    left, right = (0.3, 0.0, 2 * deg), (0.3, 0.0, -2 * deg)
-    ends = [(11.0, 9.9, -0.1), (11.0, 10.1, 0.1)]
-    s = samples([right, left], ends)
-    turning = cycle(command=(0.3, 0.0, 1 * deg), previous=(0.3, 0.0, 1 * deg))
-    eq_10 = (Heading(), Clearance(), Speed(), Facing(weight=0.3))
-    for critics, chosen in ((eq_10, right), ((*eq_10, SteadyTurn(0.01)), left)):
-        terms = np.array([c.score(candidates(s), turning) for c in critics])
-        weights = np.array([c.weight_in(CFG) for c in critics])
-        best = pick(terms, weights, 0.0, s.commands, np.full(2, 0.3), turning.command,
-                    turning.previous, 0.3, 0.01)  # fmt: skip
-        assert tuple(s.commands[best]) == chosen
 
 
 def test_eq_10s_weights_are_the_vehicles_the_profiles_own_critics_carry_theirs():

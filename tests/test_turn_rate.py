@@ -1,9 +1,10 @@
 """The default profile's turn rate: omega follows the route's turns instead of flipping.
 
 Where the sign changes came from (issue #41): DWA choosing between near-equal samples
-either side of the current turn rate (the ``SteadyTurn`` critic, written but not in the
-default profile yet), and the turns on the spot and the straight approach braking on the
-continuous curve, ending past the heading they aimed at (the next command turned back).
+either side of the current turn rate (a critic for it was tried and not kept:
+docs/planner-design.md), and the turns on the spot and the straight approach braking on
+the continuous curve, ending past the heading they aimed at (the next command turned
+back).
 """
 
 from __future__ import annotations

@@ -22,11 +22,6 @@ critic          scores                                                  profiles
 (facing.py)     direction of travel (not with ``free_heading``)
 ``OnRoute``     ``clearance_cap`` - the trajectory's largest distance   default     0.3
 (route.py)      from the route's current segment (with a segment only)
-``SteadyTurn``  alpha dt - |omega - the current omega|: the sample      (none)      (0.01-0.02)
-(turn_rate.py)  that changes the turn rate least (its spread is its
-                whole range: a small weight decides between neighbours);
-                not on: each weight tried let a pinned walker episode
-                of tests/test_local_planner.py collide (issue #41)
 ==============  ======================================================  ==========  ===============
 
 The weights of Eq. (10)'s three are the vehicle's (``DwaConfig``: Table 1's values in
