@@ -109,6 +109,15 @@ def _blocker_sensed(scene: Scene) -> None:
     scene.drive(scene.discs([], NO_DISCS), NO_DISCS)
 
 
+def _facing_away(scene: Scene) -> None:
+    """At rest facing away from the route: the initial turn on the spot (``turn_command``,
+    braked on whole periods by ``stopping_rate``), as at a stop corner."""
+    x, y, theta = scene.pose
+    pose, discs = (x, y, theta + math.pi), scene.discs([], NO_DISCS)
+    for k in range(SCENE_CYCLES):
+        scene.controller.step(pose, (0.0, 0.0, 0.0), float(k), discs, NO_DISCS)
+
+
 def _stalled_out(scene: Scene) -> None:
     """Standing still until the recovery sequence runs out: every recovery's commands."""
     controller, discs = scene.controller, scene.discs([], NO_DISCS)
@@ -151,3 +160,4 @@ def warm_up(
         scene.pose = at_start
         drive(scene)
     _stalled_out(_scene(grid, start, goal, config))
+    _facing_away(_scene(grid, start, goal, config))
