@@ -46,7 +46,7 @@ def serve_agvs(
     """Run every named AGV, each in its own process (logged in as ``logins[name]``
     when given); the worst exit status. ``exits_fd``: a pipe to the launcher, told at
     once of every AGV process that ends abnormally (see ``tell_exit``)."""
-    AgvNode(scenario, names[0]).warm_up()
+    AgvNode(scenario, names[0]).warm_up()  # also builds the map's shared layers
     logins = logins or {}
     options = (connect, prefix, connect_timeout, zenoh_config, grace)
     if len(names) == 1 and exits_fd is None:  # nobody to tell: this process is the AGV

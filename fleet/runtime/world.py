@@ -91,7 +91,7 @@ class World:
         self.collisions = 0
         self._contacts: set[frozenset[str]] = set()
         self._temporary_shown: list[list[int]] = []
-        self._static = DistanceField.from_grid(scenario.grid)
+        self._static = DistanceField.for_grid(scenario.grid)
         self._field = self._static
         self._refresh_temporary()
         self.ended = False

@@ -59,6 +59,13 @@ class DistanceField:
         samples.setflags(write=False)
         return cls(grid, s, samples)
 
+    @classmethod
+    def for_grid(cls, grid: GridMap) -> DistanceField:
+        """The field of ``grid`` at its chosen subdivision, built on first use and then
+        kept with the map: every AGV of a run (and the world) shares one, and AGV processes
+        forked after the warm-up share its pages."""
+        return grid.derived(("distance_field",), lambda: cls.from_grid(grid))
+
     @property
     def origin(self) -> tuple[float, float]:
         """World position of the map's bottom-left corner (the lattice's point (0, 0))."""

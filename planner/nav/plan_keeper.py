@@ -42,7 +42,7 @@ class PlanKeeper:
         self.config = config
         self.algorithm = GLOBAL_ALGORITHM.get(config.algorithm, "")
         self.known_cells: set[Cell] = set()  # temporary obstacles sensed so far
-        self.static_field = DistanceField.from_grid(grid)
+        self.static_field = DistanceField.for_grid(grid)
         self.field = self.static_field  # the static map plus the sensed obstacles
         # default profile: the map's costmap for this AGV (shared through the map's cache),
         # plus the temporary obstacles seen so far
@@ -65,7 +65,7 @@ class PlanKeeper:
         self.known_cells |= new
         if self.costmap is not None:
             self.costmap = self.costmap.with_blocked(new)
-        self.field = DistanceField.from_grid(self.grid.with_blocked(self.known_cells))
+        self.field = DistanceField.for_grid(self.grid.with_blocked(self.known_cells))
         self.route_stale = True
         return True
 
