@@ -1,11 +1,20 @@
-"""The bus floor: how many lockstep ticks per second the bus allows when nobody plans.
+"""The bus floors: how many lockstep ticks per second the bus allows when nobody plans.
 
 One process per AGV, as in a real run: each opens a Zenoh client session to a router
-in this process, decodes and validates every ``world/tick`` with ``bridge.bus`` and at
-once answers with a stop command. This process publishes the scenario's first tick
-again and again (its size is a real tick's), each time after every AGV has answered
-the one before. What is left of a real run's tick time beyond this is the AGVs'
-planning and the world's integration: ``fleet_bench`` prints the two side by side.
+in this process and answers every ``world/tick`` at once, in Zenoh's receiving thread
+as a real AGV does (``Bus.listen(direct=True)``). This process publishes the
+scenario's first tick again and again (its size is a real tick's), each time after
+every AGV has answered the one before. Two floors:
+
+- the *bus* floor: each AGV decodes and validates the tick with ``bridge.bus`` and
+  answers with an encoded stop command; what is left of a real run's tick time beyond
+  this is the AGVs' planning and the world's integration (``fleet_bench`` prints them
+  side by side);
+- the *Zenoh* floor (``raw=True``): the same bytes, but nobody decodes or encodes
+  anything: each AGV puts a command's bytes back as soon as a tick's bytes arrive, and
+  this process only counts them. It is what zenoh-python itself costs per round trip,
+  the ceiling of any protocol on this machine; the gap between the two floors is the
+  project's codec and checks.
 
 The AGV processes are forked by one host process (``python -m benchmarks.bus_floor``)
 that imports only ``bridge`` and has no Zenoh session yet, as the AGV host of a real run
@@ -22,18 +31,23 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
+import zenoh
+
 from bridge import keys
-from bridge.bus import Bus
+from bridge.bus import Bus, Received
 from bridge.messages import AgvCommand
 from bridge.session import fresh_endpoint, open_client, open_router
+from bridge.wire import to_wire
 
 PREFIX = "bench/bus-floor"
 WARM_UP_TICKS = 20
 ANSWER_TIMEOUT_S = 30.0
-START_S_PER_AGV = 1.0  # the wait for every AGV's first answer: 20 s plus this per AGV
+START_S_PER_AGV = 1.0
+RESEND_SETTLE_S = 1.0  # the wait for every AGV's first answer: 20 s plus this per AGV
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -41,18 +55,39 @@ class FloorError(RuntimeError):
     """The floor could not be measured (an AGV process did not answer)."""
 
 
-def _answer_at_once(endpoint: str, name: str) -> None:
-    """An AGV process that answers every tick with a stop, until the final tick."""
+def _answer_at_once(endpoint: str, name: str, raw: bool) -> None:
+    """An AGV process that answers every tick with a stop, until the final tick (raw: an
+    empty payload)."""
     bus = Bus(open_client(endpoint), PREFIX)
-    ticks = bus.subscribe(keys.WORLD_TICK)
-    while True:
-        tick = ticks.get().msg
-        if tick.final:
-            return
-        bus.publish(keys.agv_command(name), AgvCommand(name, tick.tick + 1, 0.0, 0.0, 0.0))
+    key = keys.agv_command(name)
+    over = threading.Event()
+    if raw:
+        stop = to_wire(key, AgvCommand(name, 1, 0.0, 0.0, 0.0))
+
+        def answer_bytes(sample: zenoh.Sample) -> None:
+            if len(sample.payload) == 0:
+                over.set()
+            else:
+                bus.publish_payload(key, stop)
+
+        handler = zenoh.handlers.Callback(answer_bytes, indirect=False)
+        subscriber = bus.session.declare_subscriber(bus.full(keys.WORLD_TICK), handler)
+    else:
+
+        def answer(received: Received) -> None:
+            tick = received.msg
+            if tick.final:
+                over.set()
+            else:
+                bus.publish(key, AgvCommand(name, tick.tick + 1, 0.0, 0.0, 0.0))
+
+        bus.listen(keys.WORLD_TICK, answer, direct=True)
+    over.wait()
+    if raw:
+        subscriber.undeclare()
 
 
-def _host(endpoint: str, names: list[str]) -> None:
+def _host(endpoint: str, raw: bool, names: list[str]) -> None:
     """Fork one answering process per AGV (no Zenoh session exists here) and wait."""
     children = []
     for name in names:
@@ -60,7 +95,7 @@ def _host(endpoint: str, names: list[str]) -> None:
         if pid == 0:
             code = 1
             try:
-                _answer_at_once(endpoint, name)
+                _answer_at_once(endpoint, name, raw)
                 code = 0
             finally:
                 os._exit(code)
@@ -69,17 +104,31 @@ def _host(endpoint: str, names: list[str]) -> None:
         os.waitpid(pid, 0)
 
 
-def bus_floor_ticks_per_s(tick, dt: float, ticks: int = 200) -> float:
+def bus_floor_ticks_per_s(tick, dt: float, ticks: int = 200, raw: bool = False) -> float:
     """Ticks per second of the lockstep over Zenoh with AGV processes that do not plan,
-    ``tick`` (a real first tick) published again and again; FloorError if it cannot be
-    measured."""
+    ``tick`` (a real first tick) published again and again (``raw``: its bytes, neither
+    decoded nor checked: the Zenoh floor); FloorError if it cannot be measured."""
     names = [state.name for state in tick.agvs]
     with tempfile.TemporaryDirectory() as folder:
         endpoint = fresh_endpoint("unix", folder)
         bus = Bus(open_router(endpoint), PREFIX)
-        commands = bus.subscribe("agv/*/command")
+        commands: queue.SimpleQueue = queue.SimpleQueue()  # (name, tick answered: None raw)
+        if raw:
+            subscriber = bus.session.declare_subscriber(
+                bus.full("agv/*/command"),
+                lambda sample: commands.put((str(sample.key_expr), None)),
+            )
+        else:
+            bus.listen("agv/*/command", lambda got: commands.put((got.msg.name, got.msg.tick)))
         host = subprocess.Popen(
-            [sys.executable, "-m", "benchmarks.bus_floor", endpoint, *names],
+            [
+                sys.executable,
+                "-m",
+                "benchmarks.bus_floor",
+                endpoint,
+                "raw" if raw else "bus",
+                *names,
+            ],
             cwd=ROOT,
             start_new_session=True,
         )
@@ -102,13 +151,17 @@ def bus_floor_ticks_per_s(tick, dt: float, ticks: int = 200) -> float:
                         bus.publish(keys.WORLD_TICK, tick)
                         sent = now
                     try:
-                        msg = commands.get(timeout=0.1).msg
+                        name, answered_tick = commands.get(timeout=0.1)
                     except queue.Empty:
                         continue
-                    if msg.tick == k + 1:
-                        answered.add(msg.name)
+                    if answered_tick in (None, k + 1):
+                        answered.add(name)
 
             one_tick(0, 20.0 + START_S_PER_AGV * len(names), resend=0.5)
+            time.sleep(RESEND_SETTLE_S)  # a raw answer names no tick: drop those to resends
+            with contextlib.suppress(queue.Empty):
+                while True:
+                    commands.get_nowait()
             for k in range(1, WARM_UP_TICKS):
                 one_tick(k, ANSWER_TIMEOUT_S)
             start = time.perf_counter()
@@ -116,9 +169,14 @@ def bus_floor_ticks_per_s(tick, dt: float, ticks: int = 200) -> float:
                 one_tick(k, ANSWER_TIMEOUT_S)
             rate = ticks / (time.perf_counter() - start)
             tick.final = True
-            bus.publish(keys.WORLD_TICK, tick)
+            if raw:
+                bus.publish_payload(keys.WORLD_TICK, b"")
+            else:
+                bus.publish(keys.WORLD_TICK, tick)
             with contextlib.suppress(subprocess.TimeoutExpired):
                 host.wait(10.0)
+            if raw:
+                subscriber.undeclare()
         finally:
             if host.poll() is None:
                 os.killpg(host.pid, signal.SIGKILL)
@@ -128,4 +186,4 @@ def bus_floor_ticks_per_s(tick, dt: float, ticks: int = 200) -> float:
 
 
 if __name__ == "__main__":
-    _host(sys.argv[1], sys.argv[2:])
+    _host(sys.argv[1], sys.argv[2] == "raw", sys.argv[3:])
