@@ -18,6 +18,7 @@ from planner.nav.fusion import FusionConfig, FusionController
 from planner.nav.goal_checker import GoalChecker
 from planner.nav.key_node_targets import KeyNodeTargets
 from planner.nav.mode import Mode
+from planner.nav.old_ground import OldGround
 from planner.nav.progress_checker import ProgressChecker
 from planner.nav.recovery_sequence import JAM_RESTARTS, RecoverySequence
 
@@ -183,8 +184,57 @@ def test_standing_still_runs_the_recovery_sequence_and_then_fails():
     assert controller.failure.startswith("no progress after the recoveries replan, wait")
 
 
+def _stall_times(script, steps: int) -> dict[float, str]:
+    """The recoveries a controller on the open floor (goal (8.5, 2.5)) starts, by time, with
+    its position along y = 2.5 at each time given by ``script``."""
+    controller = FusionController(_open_floor(), (8.5, 2.5), FusionConfig())
+    controller.start((script(0.0), 2.5, 0.0))
+    started = {}
+    for k in range(steps):
+        out = controller.step((script(k * DT), 2.5, 0.0), (0.0, 0.0, 0.0), k * DT)
+        if out.recovery:
+            started[k * DT] = out.recovery
+    return started
+
+
+def test_driving_back_to_where_the_agv_stalled_is_no_progress():
+    # stalled at x = 4.5, then moved back to x = 2.5 and stalled there again; then driven
+    # up to x = 4.5 once more. The route from x = 2.5 shrinks as it goes, but all of it is
+    # where the sequence has been: the next recovery comes a window after the wait, as
+    # if it stood; driven on beyond x = 4.5 it is progress again
+    def back_and_forth(up_to: float):
+        def x(now: float) -> float:
+            if now < 6.0:
+                return 4.5
+            if now < 10.0:
+                return 4.5 - 0.5 * (now - 6.0)
+            return min(2.5 + max(0.0, now - 14.0), up_to)
+
+        return x
+
+    back = _stall_times(back_and_forth(4.5), 50)
+    assert list(back.items()) == [(5.5, REPLAN), (10.5, WAIT), (18.5, BACK_OFF)]
+    onwards = _stall_times(back_and_forth(8.0), 50)
+    assert list(onwards.items()) == [(5.5, REPLAN), (10.5, WAIT), (24.5, BACK_OFF)]
+
+
+def test_old_ground_is_where_a_sequence_was_up_to_its_last_stall():
+    ground = OldGround(reach=0.3)
+    ground.note((0.0, 0.0))  # no sequence yet: nothing kept
+    ground.stall((1.0, 0.0))
+    for x in (1.2, 1.4, 1.6, 1.8, 2.0):
+        ground.note((x, 0.0))
+    assert not ground.reached((0.0, 0.0)) and ground.reached((1.2, 0.1))
+    assert not ground.reached((1.8, 0.0))  # reached since the last stall: not old yet
+    ground.stall((2.0, 0.0))
+    assert ground.reached((1.8, 0.0)) and not ground.reached((2.5, 0.0))
+    ground.clear()
+    assert not ground.reached((1.2, 0.0))
+
+
 def test_a_jammed_sequence_starts_again_before_it_fails():
-    sequence = RecoverySequence(progress_window=5.0)
-    kinds = [sequence.next(10.0 * k, agv_near=True) for k in range(6 * (JAM_RESTARTS + 1) + 1)]
+    sequence = RecoverySequence(progress_window=5.0, progress_distance=0.3)
+    stalls = range(6 * (JAM_RESTARTS + 1) + 1)
+    kinds = [sequence.next(10.0 * k, (0.0, 0.0), agv_near=True) for k in stalls]
     assert kinds[-1] is None and None not in kinds[:-1]
     assert kinds[:6] == [REPLAN, WAIT, WAIT, REPLAN, WAIT, REPLAN]  # no back-off into others

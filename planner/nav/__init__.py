@@ -15,7 +15,8 @@ local targets, recoveries; the top of ``planner``.
 - ``progress_checker.ProgressChecker`` (Nav2's ProgressChecker): no progress along the
   route for the progress window is a stall.
 - ``recovery_sequence.RecoverySequence``: at each stall the next recovery (replan, wait,
-  back off, rotate; the commands in ``recovery``), bounded, then failed with the reason.
+  back off, rotate; the commands in ``recovery``), bounded, then failed with the reason;
+  coming back where its stalls have been (``old_ground.OldGround``) is no progress.
 - ``turn_round.TurnRound``: the turn on the spot towards a target behind.
 - ``dwa_inputs``: what DWA is given beyond its target (the route segment, kept to the
   right of an AGV coming; the braking room ahead) and the straight approach that takes
@@ -24,11 +25,11 @@ local targets, recoveries; the top of ``planner``.
   recovering, waiting, arrived, failed).
 
 A control cycle (``FusionController.step``) reads top-down: observe (the trail of where
-the AGV went); check the goal (arrived, or brake inside the tolerance); go on with a turn
-in place or a timed recovery under way; replan at once when what was seen blocks the
-route; wait where the traffic rule holds the AGV; check progress (a stall starts the next
-recovery); pick the target (switch key nodes); plan locally (a turn round, the straight
-approach to a tight corner, or DWA) and command.
+the AGV went, and where a sequence of stalls took it); check the goal (arrived, or brake
+inside the tolerance); go on with a turn in place or a timed recovery under way; replan
+at once when what was seen blocks the route; wait where the traffic rule holds the AGV;
+check progress (a stall starts the next recovery); pick the target (switch key nodes);
+plan locally (a turn round, the straight approach to a tight corner, or DWA) and command.
 
 ``warm_up`` drives a controller through a run's situations before a run, so that no
 compiled kernel loads mid-run.

@@ -99,7 +99,9 @@ class FusionController:
         self.key_nodes = KeyNodeTargets(self.config, self.behaviour, goal)
         self.goal_checker = GoalChecker(self.config.goal_tolerance, self.behaviour.smooth_arrival)
         self.progress = ProgressChecker(self.config.progress_window, self.config.progress_distance)
-        self.recoveries = RecoverySequence(self.config.progress_window)
+        self.recoveries = RecoverySequence(
+            self.config.progress_window, self.config.progress_distance
+        )
         self.turn_round = TurnRound(self.config.dwa, self.behaviour.turn_round)
         self.trail = Trail()  # the way it came: where a head-on walker walks on
         self.mode = Mode.DRIVING
@@ -231,6 +233,7 @@ class FusionController:
         # observe
         position = (pose[0], pose[1])
         self.trail.note(position)
+        self.recoveries.ground.note(position)
         # check the goal
         if self.may_arrive and self.goal_checker.within(position, self.goal):
             if self.goal_checker.is_goal_reached(position, self.goal, command):
@@ -315,8 +318,10 @@ class FusionController:
         return plan
 
     def _no_progress(self, position: Point, now: float) -> bool:
-        """The progress checker's verdict; progress also tells the recovery sequence."""
-        if self.progress.check(self.key_nodes.remaining(position), now):
+        """The progress checker's verdict, where the stalls have not been before; progress
+        also tells the recovery sequence."""
+        back = self.recoveries.ground.reached(position)
+        if not back and self.progress.check(self.remaining(position), now):
             self.recoveries.progressed(now)
             return False
         return self.progress.stalled(now)
@@ -329,7 +334,7 @@ class FusionController:
             plan = self._plan_from(position)
             self.progress.restart(math.inf, now)
             return plan
-        kind = self.recoveries.next(now, agv_near(position, moving, walkers))
+        kind = self.recoveries.next(now, position, agv_near(position, moving, walkers))
         if kind is None:
             self.mode = Mode.FAILED
             self.failure = (

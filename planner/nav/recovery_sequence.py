@@ -6,7 +6,8 @@ another AGV near, a back-off or rotation is a wait instead: the others plan too,
 moving into their room only pushes them. An AGV that had another near at one of the
 sequence's stalls is in a jam of AGVs, not at a dead end, and starts the sequence again
 (``JAM_RESTARTS`` times) before it fails. Progress kept up for ``CALM_WINDOWS`` progress
-windows after the last stall starts the sequence from its first recovery again.
+windows after the last stall starts the sequence from its first recovery again; coming
+back to where the sequence has been is no progress (``planner.nav.old_ground``).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 from planner.core.status import BACK_OFF, ROTATE, WAIT
 from planner.local.yielding import agvs_of
 from planner.maps.grid import Point
+from planner.nav.old_ground import OldGround
 from planner.nav.recovery import DURATION_S, RECOVERIES, Recovery
 
 CALM_WINDOWS = 3
@@ -39,8 +41,9 @@ END_SLACK = 1e-9
 class RecoverySequence:
     """Which recoveries this stall sequence has run, and the one running now."""
 
-    def __init__(self, progress_window: float):
+    def __init__(self, progress_window: float, progress_distance: float):
         self.progress_window = progress_window
+        self.ground = OldGround(progress_distance)  # where the sequence has been
         self.run: list[str] = []  # the kinds this sequence has started
         self.jam_restarts = 0  # sequences started again in a jam
         self.jammed = False  # another AGV was near at a stall of this sequence
@@ -53,11 +56,13 @@ class RecoverySequence:
         if now - self.last_stall >= CALM_WINDOWS * self.progress_window:
             self.run, self.jam_restarts = [], 0
             self.jammed = False
+            self.ground.clear()
 
-    def next(self, now: float, agv_near: bool) -> str | None:
-        """The recovery to start at the stall at ``now`` (``agv_near``: another AGV within
-        ``JAM_RANGE``); None when the sequence has run out: the AGV fails."""
+    def next(self, now: float, position: Point, agv_near: bool) -> str | None:
+        """The recovery to start at the stall at ``now`` and ``position`` (``agv_near``:
+        another AGV within ``JAM_RANGE``); None when the sequence has run out: the AGV fails."""
         self.last_stall = now
+        self.ground.stall(position)
         self.jammed = self.jammed or agv_near
         exhausted = len(self.run) >= len(RECOVERIES)
         if exhausted and self.jammed and self.jam_restarts < JAM_RESTARTS:
