@@ -18,7 +18,6 @@ from planner.local.critics.facing import Facing
 from planner.local.critics.heading import Heading
 from planner.local.critics.route import OnRoute
 from planner.local.critics.speed import Speed
-from planner.local.critics.turn_rate import SteadyTurn
 from planner.local.cycle import Cycle
 from planner.local.dwa import DwaPlanner
 from planner.local.fallback import Brake, Evade
@@ -110,46 +109,11 @@ def test_on_route_scores_the_cap_less_the_offset_and_needs_a_segment():
     assert OnRoute(0.3).applies(on_segment) and not OnRoute(0.3).applies(cycle())
 
 
-def test_steady_turn_scores_how_little_a_sample_changes_the_turn_rate():
-    dw = CFG.max_alpha * CFG.dt  # 5 deg/s
-    deg = math.pi / 180
-    s = samples([(0.3, 0.0, w * deg) for w in (-4, 0, 2, 3, 7)], [(11.0, 10.0, 0.0)] * 5)
-    turning = cycle(command=(0.3, 0.0, 2 * deg))
-    expected = [0.0, dw - 2 * deg, dw, dw - 1 * deg, 0.0]  # at least 0
-    np.testing.assert_allclose(SteadyTurn(0.015).score(candidates(s), turning), expected)
-
-
-def test_of_two_equal_samples_either_side_the_default_keeps_the_turn_under_way():
-    # the target dead ahead: turning 2 deg/s left or right scores the same by Eq. (10) and
-    # facing; turning left at 1 deg/s, the default's choice goes on left (without the
-    # steady turn the first of the equals, right: the swing from side to side)
-    deg = math.pi / 180
-    left, right = (0.3, 0.0, 2 * deg), (0.3, 0.0, -2 * deg)
-    s = samples([right, left], [(11.0, 9.9, -0.1), (11.0, 10.1, 0.1)])
-    turning = cycle(command=(0.3, 0.0, 1 * deg), previous=(0.3, 0.0, 1 * deg))
-    eq_10 = (Heading(), Clearance(), Speed(), Facing(weight=0.3))
-    for critics, chosen in ((eq_10, right), ((*eq_10, SteadyTurn(0.015)), left)):
-        terms = np.array([c.score(candidates(s), turning) for c in critics])
-        weights = np.array([c.weight_in(CFG) for c in critics])
-        best = pick(terms, weights, 0.0, s.commands, np.full(2, 0.3), turning.command,
-                    turning.previous, 0.3, 0.01)  # fmt: skip
-        assert tuple(s.commands[best]) == chosen
-
-
-def test_steady_turn_steps_aside_while_a_walker_is_coming_not_once_it_walks_away():
-    # at (10, 10): a walker 5 m ahead walking at the AGV, then the same walker walking off
-    coming = np.array([[15.0, 10.0, -1.0, 0.0, 0.35]])
-    going = np.array([[15.0, 10.0, 1.0, 0.0, 0.35]])
-    critic = SteadyTurn(0.015)
-    assert critic.applies(cycle()) and critic.applies(cycle(walkers=going))
-    assert not critic.applies(cycle(walkers=coming))
-
-
 def test_eq_10s_weights_are_the_vehicles_the_profiles_own_critics_carry_theirs():
     cfg = DwaConfig(alpha=0.4, beta=0.5, gamma=0.6)
     assert [c.weight_in(cfg) for c in PAPER_BEHAVIOUR.critics] == [0.4, 0.5, 0.6]
     own = {c.name: c.weight_in(cfg) for c in DEFAULT_BEHAVIOUR.critics[3:]}
-    assert own == {"facing": 0.3, "on_route": 0.3, "steady_turn": 0.015}
+    assert own == {"facing": 0.3, "on_route": 0.3}
 
 
 # the choice ------------------------------------------------------------------------------

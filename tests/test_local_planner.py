@@ -303,7 +303,7 @@ def test_the_body_faces_its_direction_of_travel_unless_free_heading_is_asked():
     _, paper = run(with_profile(sc, "paper"))
     # the default's sideways share is where it passes a tight corner with the walker within
     # 12 m: DWA then passes the node as the paper does, turning the body while it drives
-    # (14 %); the paper slides sideways most of the run (93 %)
+    # (12 %); the paper slides sideways most of the run (93 %)
     assert _sideways_share(default) < 0.2
     assert _sideways_share(paper) > 0.5
 

@@ -22,7 +22,6 @@ from planner.local.critics.facing import Facing
 from planner.local.critics.heading import Heading
 from planner.local.critics.route import OnRoute
 from planner.local.critics.speed import Speed
-from planner.local.critics.turn_rate import SteadyTurn
 from planner.local.fallback import Brake, Evade
 from planner.local.filters import Admissible, ArrivalSpeed, Filter, NoRetreat, YieldEarly
 
@@ -74,7 +73,6 @@ DEFAULT_BEHAVIOUR = LocalBehaviour(
         *EQ_10,
         Facing(weight=0.3),  # the body faces its travel: sensors and narrow side ahead
         OnRoute(weight=0.3),  # lined up with a narrow passage before it gets there
-        SteadyTurn(weight=0.015),  # omega follows the route's turns, not either side of them
     ),
     filters=(
         Admissible(),  # Eq. (7), with the lane's braking room along the route

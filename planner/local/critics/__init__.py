@@ -22,9 +22,6 @@ critic          scores                                                  profiles
 (facing.py)     direction of travel (not with ``free_heading``)
 ``OnRoute``     ``clearance_cap`` - the trajectory's largest distance   default     0.3
 (route.py)      from the route's current segment (with a segment only)
-``SteadyTurn``  alpha dt - |omega - the current omega|: omega          default     0.015
-(turn_rate.py)  follows the route's turns, not either side of them
-                (not while a walker is coming)
 ==============  ======================================================  ==========  ===============
 
 The weights of Eq. (10)'s three are the vehicle's (``DwaConfig``: Table 1's values in
