@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+import zenoh
 
 from bridge import keys
 from bridge.bus import Bus
@@ -77,7 +78,9 @@ class Run:
         return Login(user, self.credentials[user])
 
     def put(self, session, key: str, payload: bytes) -> None:
-        session.put(self.bus.full(key), payload)
+        """``payload`` on ``key``, blocking rather than dropped when the link is busy: a put
+        Zenoh drops under load never reaches the node whose handling the test asserts."""
+        session.put(self.bus.full(key), payload, congestion_control=zenoh.CongestionControl.BLOCK)
 
 
 @contextmanager
@@ -286,13 +289,27 @@ def _command_dict(tick: int) -> dict:
     return to_dict(forged_command("left", tick))
 
 
+def _world_keys(attack_name: str, run: Run) -> set[str]:
+    """The keys whose invalid messages the world counts in ``attack_name`` (none of the 50
+    MB one: Zenoh drops it before any node sees it)."""
+    if attack_name == "50 MB message":
+        return set()
+    return {k for k, _ in ATTACKS[attack_name](run) if k.endswith("/command")}
+
+
 @pytest.mark.parametrize("attack_name", list(ATTACKS))
 def test_an_open_run_shrugs_off(attack_name, undisturbed):
     def attack(run: Run):
         with open_client(run.endpoint, timeout=5) as s:
             for key, payload in ATTACKS[attack_name](run):
                 run.put(s, key, payload)
-            time.sleep(0.3)  # let the last ones arrive before the session closes
+            # the world resumes once they have arrived (on a loaded machine 0.3 s was not
+            # always enough), and the AGVs' copies get the same time
+            expected = _world_keys(attack_name, run)
+            deadline = time.monotonic() + 10.0
+            while not expected <= set(run.bus.invalid) and time.monotonic() < deadline:
+                time.sleep(0.05)
+            time.sleep(0.3)
 
     with fleet_on_bus(guarded=False) as run:
         summary = run_under_attack(run, attack)
@@ -304,8 +321,7 @@ def test_an_open_run_shrugs_off(attack_name, undisturbed):
         assert not run.bus.invalid and not agv_errors
         return
     # every invalid message is counted where it arrives, and logged once per key and process
-    world_keys = {k for k, _ in ATTACKS[attack_name](run) if k.endswith("/command")}
-    assert set(run.bus.invalid) == world_keys
+    assert set(run.bus.invalid) == _world_keys(attack_name, run)
     for line in agv_errors.splitlines():
         assert line.startswith("agv-fleet: ignoring invalid message on world/tick: "), line
     if any(k == keys.WORLD_TICK for k, _ in ATTACKS[attack_name](run)):
