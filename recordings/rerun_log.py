@@ -17,7 +17,7 @@ import rerun as rr
 from bridge import keys
 from planner.core.motion import CONTROL_PERIOD
 from recordings.rerun_blueprint import Bounds, blueprint
-from recordings.rerun_fleet import fleet_rows, fleet_style_rows
+from recordings.rerun_fleet import FleetCounts, fleet_style_rows
 from recordings.rerun_rows import AGV_ROW_TOPICS, TIMELINE, Row, RowMaker, map_bounds
 
 LIVE_PERIOD = 0.1  # s of wall time between sends of a live view
@@ -63,11 +63,11 @@ def _nanoseconds(seconds: list[float]) -> np.ndarray:
     return np.round(np.asarray(seconds) * 1e9).astype(np.int64).astype("timedelta64[ns]")
 
 
-def rows_of(maker: RowMaker, topic: str, data: dict) -> list[Row]:
+def rows_of(maker: RowMaker, fleet: FleetCounts, topic: str, data: dict) -> list[Row]:
     """The rows of one message: its own, and the fleet's counts at a tick."""
     rows = maker.feed(topic, data)
     if topic == keys.WORLD_TICK:
-        rows += fleet_rows(data)
+        rows += fleet.rows(data)
     return rows
 
 
@@ -99,11 +99,11 @@ def send_recording(
     then the recording converted (``stations``: a shift's, ``rerun_tasks.stations_of``)."""
     names, bounds, end_time = layout_of(messages)
     stream.send_blueprint(blueprint(names, bounds, end_time, follow=follow, rate=rate))
-    maker = RowMaker(recording_dt(messages), stations)
+    maker, fleet = RowMaker(recording_dt(messages), stations), FleetCounts()
     columns = Columns(stream)
     columns.add(fleet_style_rows())
     for m in messages:
-        columns.add(rows_of(maker, m.topic, m.data))
+        columns.add(rows_of(maker, fleet, m.topic, m.data))
     columns.send()
 
 
@@ -115,12 +115,13 @@ class Live:
     def __init__(self, stream: rr.RecordingStream, dt: float, stations=()):
         self._stream = stream
         self._maker = RowMaker(dt, stations)
+        self._fleet = FleetCounts()
         self._columns = Columns(stream)
         self._shown: tuple | None = None  # (AGVs, map bounds) of the blueprint sent
         self._due = time.monotonic() + LIVE_PERIOD
 
     def feed(self, topic: str, data: dict) -> None:
-        rows = rows_of(self._maker, topic, data)
+        rows = rows_of(self._maker, self._fleet, topic, data)
         shown = (len(self._maker.agv_names), self._maker.map_bounds)
         if shown != self._shown:
             self._stream.send_blueprint(blueprint(self._maker.agv_names, shown[1]))

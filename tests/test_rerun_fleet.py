@@ -14,6 +14,7 @@ from rerun.chunk import RrdReader
 from fleet.cli.main import main
 from recordings.reader import open_recording
 from recordings.rerun_blueprint import blueprint
+from recordings.rerun_fleet import STANDING_S, STATE_PLOT, FleetCounts
 from recordings.rerun_log import layout_of, recording_dt
 from recordings.rerun_rows import RowMaker
 from recordings.rerun_view import Outputs, save_rrd
@@ -107,3 +108,29 @@ def test_the_fleet_counts_add_up_at_every_tick_and_end_with_the_arrivals(crossin
     assert arrived[-1][0] == sum(a["status"] == "arrived" for a in result)
     assert max(c[0] for c in counts["waiting"]) >= 1  # the lane makes AGVs wait
     assert max(c[0] for c in counts["driving"]) >= total - 1
+
+
+def _tick(time: float, speed: float, omega: float = 0.0, status: str = "driving") -> dict:
+    agv = {"name": "a", "status": status, "vx": speed, "vy": 0.0, "omega": omega}
+    return {"time": time, "agvs": [agv]}
+
+
+def _state_at(counts: FleetCounts, tick: dict) -> str:
+    rows = {r.path: r.payload for r in counts.rows(tick)}
+    return next(s for s in STATES if rows[f"{STATE_PLOT}/{s}"] == 1)
+
+
+def test_a_pause_before_a_turn_on_the_spot_is_driving_and_standing_still_is_stopped():
+    counts = FleetCounts()
+    # braking to a tight corner's node: below AT_REST for two ticks, then turning
+    brake_and_turn = [_tick(0.0, 0.2), _tick(0.1, 0.03), _tick(0.2, 0.01), _tick(0.3, 0.0, 0.09)]
+    assert [_state_at(counts, t) for t in brake_and_turn] == ["driving"] * 4
+    # at rest from 0.4 s on: driving until STANDING_S has passed, then stopped
+    rest = [_tick(0.4 + 0.1 * k, 0.0) for k in range(15)]
+    states = [_state_at(counts, t) for t in rest]
+    standing = round(STANDING_S / 0.1)
+    assert states == ["driving"] * standing + ["stopped"] * (len(rest) - standing)
+    # moving again resets it; an AGV blocked or failed at rest is stopped at once
+    assert _state_at(counts, _tick(2.0, 0.3)) == "driving"
+    assert _state_at(counts, _tick(2.1, 0.0, status="blocked")) == "stopped"
+    assert _state_at(FleetCounts(), _tick(0.0, 0.0, status="failed")) == "stopped"
