@@ -14,10 +14,14 @@ from bridge import keys
 from fleet.runtime.inprocess import run_in_process
 from planner.core.motion import step_pose
 from planner.core.path_metrics import turn_angle
+from planner.local.behaviour import local_behaviour
 from planner.local.config import DwaConfig
+from planner.local.dwa import DwaPlanner
+from planner.local.yielding import WALKER_RANGE
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import GridMap
 from planner.maps.text_maps import parse_text_grid
+from planner.nav.dwa_inputs import straight_approach
 from planner.nav.fusion import FusionConfig, FusionController
 from planner.nav.tight_turns import (
     MIN_REACH,
@@ -146,3 +150,33 @@ def test_only_the_default_profile_stops_at_tight_corners():
         if profile == "paper":
             assert all(c.reach == config.switch_distance for c in controller.corners)
     assert any(stops["default"]) and not any(stops["paper"])
+
+
+def _approach(walkers, stalled_before=None):
+    """The straight approach from (2, 6) to the node (4.5, 6) in an open room, the route
+    turning north there, with ``walkers`` (rows [x, y, vx, vy, r]) about."""
+    field = DistanceField.from_grid(parse_text_grid("\n".join(["." * 20] * 12)))
+    config = FusionConfig()
+    dwa = DwaPlanner(config.dwa, field, local_behaviour(config.profile))
+    pose, command, node = (2.0, 6.0, 0.0), (0.3, 0.0, 0.0), (4.5, 6.0)
+    moving = None if walkers is None else np.array(walkers, dtype=float)
+    route = [pose[:2], node, (4.5, 10.0)]
+    return straight_approach(
+        config, dwa, pose, command, node, moving, moving, stalled_before, route, [pose[:2]]
+    )
+
+
+def test_a_walker_that_cannot_reach_the_approach_leaves_it_on_one_that_can_keeps_it_off():
+    assert _approach(None) is not None
+    # 5.5 m beyond the node, within 12 m: walking away, or across far behind the node
+    assert _approach([[10.0, 6.0, 0.5, 0.0, 0.35]]) is not None
+    assert _approach([[10.0, 6.0, 0.0, 0.5, 0.35]]) is not None
+    # the same walker walking at the node reaches it before the AGV could yield there
+    assert _approach([[10.0, 6.0, -0.5, 0.0, 0.35]]) is None
+    # one standing may start at any time: off, unless the AGV already stalled before
+    # this node and every walker in range stands
+    standing = [[10.0, 6.0, 0.0, 0.0, 0.35]]
+    assert _approach(standing) is None
+    assert _approach(standing, stalled_before=(4.5, 6.0)) is not None
+    # a walker out of range standing does not count
+    assert _approach([[2.0 + WALKER_RANGE + 1.0, 6.0, 0.0, 0.0, 0.35]]) is not None

@@ -7,7 +7,14 @@ import numpy as np
 import pytest
 
 from planner.core.path_metrics import distance_to_path
-from planner.local.yielding import WALKER_RANGE, sweep, walker_coming, walker_near, walkers_standing
+from planner.local.yielding import (
+    WALKER_RANGE,
+    sweep,
+    walker_coming,
+    walker_near,
+    walker_standing_near,
+    walkers_standing,
+)
 from planner.nav.trail import TRAIL_LENGTH, TRAIL_STEP, Trail
 
 POSE = (5.0, 5.0, 0.0)
@@ -50,6 +57,14 @@ def test_standing_means_every_walker_in_range_stands_still():
     assert walkers_standing(POSE, standing)
     assert walkers_standing(POSE, standing + far_walking)  # out of range: does not count
     assert not walkers_standing(POSE, standing + walking)
+
+
+def test_standing_near_means_one_walker_in_range_stands_still():
+    standing, walking = _walker(8.0, 5.0, 0.0, 0.0), _walker(3.0, 5.0, 0.0, 0.4)
+    far_standing = _walker(5.0 + WALKER_RANGE + 1.0, 5.0, 0.0, 0.0)
+    assert walker_standing_near(POSE, standing + walking)
+    assert not walker_standing_near(POSE, walking + far_standing)
+    assert not walker_standing_near(POSE, None)
 
 
 def test_a_head_on_walker_walks_on_past_the_agv_along_the_way_the_agv_came():

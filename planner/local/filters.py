@@ -26,7 +26,7 @@ from planner.core.physics import braking_speed
 from planner.local.cycle import Cycle
 from planner.local.no_retreat import ahead_on_route, retreating
 from planner.local.samples import Samples
-from planner.local.yielding import YIELD_SLACK, agvs_of, parked_clearance, yield_horizon
+from planner.local.yielding import YIELD_SLACK, agvs_of, clearance_later
 
 _EPS = 1e-9
 
@@ -84,11 +84,9 @@ class YieldEarly:
         cfg, command = cycle.config, cycle.command
         walkers = np.asarray(cycle.walkers, dtype=float).reshape(-1, 5)
         speed = math.hypot(command[0], command[1])
-        horizon = yield_horizon(cfg, speed, float(walkers[:, 4].max()))
-        later = parked_clearance(
-            samples.xs[:, -1], samples.ys[:, -1], walkers, cycle.route, cfg.horizon_s,
-            horizon, cfg.radius, cycle.came_by,
-        )  # fmt: skip
+        later = clearance_later(
+            cfg, samples.xs[:, -1], samples.ys[:, -1], walkers, speed, cycle.route, cycle.came_by
+        )
         clear = mask & (later > 0.0)
         if clear.any():
             return clear

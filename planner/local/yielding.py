@@ -140,15 +140,29 @@ def parked_clearance(
     return out
 
 
+def clearance_later(
+    config: DwaConfig, end_x: np.ndarray, end_y: np.ndarray, walkers: np.ndarray,
+    speed: float, route: Sequence[Point] | None, came_by: Sequence[Point] = (),
+) -> np.ndarray:  # fmt: skip
+    """(N,) the least clearance between the AGV left standing at each end point of its
+    rollout (``end_x``, ``end_y``) and the ``walkers`` walking on from then until the
+    ``yield_horizon`` (from ``speed``): what early yield asks of DWA's samples
+    (``planner.local.filters.YieldEarly``) and the straight approach of its end."""
+    horizon = yield_horizon(config, speed, float(walkers[:, 4].max()))
+    return parked_clearance(
+        end_x, end_y, walkers, route, config.horizon_s, horizon, config.radius, came_by
+    )
+
+
 STILL = 0.01
 """m/s: a walker slower than this stands still."""
 
 WALKER_RANGE = 12.0
 """m: with a walker this near, the AGV leaves the room to yield: no straight approach to a
-tight corner (``planner.nav.tight_turns``), no speeding up out of a steady choice (DWA) while
-it is not walking away. A walker at 1 m/s and an AGV at 2 m/s close 12 m in 4 s, about
-the yield horizon at Table 1's limits (nav_bench: 4, 6, 8 m left 2, 2, 1 collisions;
-12 m, 1)."""
+tight corner (``planner.nav.tight_turns``) while it stands still, no speeding up out of a
+steady choice (DWA) while it is not walking away. A walker at 1 m/s and an AGV at 2 m/s
+close 12 m in 4 s, about the yield horizon at Table 1's limits (nav_bench: 4, 6, 8 m left
+2, 2, 1 collisions; 12 m, 1)."""
 
 
 def _walkers_in_range(pose, walkers) -> np.ndarray:
@@ -162,6 +176,13 @@ def _walkers_in_range(pose, walkers) -> np.ndarray:
 def walker_near(pose, walkers) -> bool:
     """Whether a walker (rows [x, y, vx, vy, r]) is within ``WALKER_RANGE`` of ``pose``."""
     return len(_walkers_in_range(pose, walkers)) > 0
+
+
+def walker_standing_near(pose, walkers) -> bool:
+    """Whether a walker within ``WALKER_RANGE`` of ``pose`` stands still: it may start
+    towards the AGV at any time."""
+    near = _walkers_in_range(pose, walkers)
+    return bool((np.hypot(near[:, 2], near[:, 3]) < STILL).any())
 
 
 def walkers_standing(pose, walkers) -> bool:

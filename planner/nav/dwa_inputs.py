@@ -20,7 +20,13 @@ from planner.local.behaviour import LocalBehaviour
 from planner.local.dwa import DwaPlanner
 from planner.local.keep_right import agv_coming, right_offset, shifted_right
 from planner.local.lane_speed import oncoming, route_room
-from planner.local.yielding import agvs_of, walker_near, walkers_standing
+from planner.local.yielding import (
+    agvs_of,
+    clearance_later,
+    walker_near,
+    walker_standing_near,
+    walkers_standing,
+)
 from planner.maps.grid import Point
 from planner.nav.config import FusionConfig
 from planner.nav.tight_turns import Corner, approach_command, approach_path
@@ -63,21 +69,29 @@ def lane_room(
 
 def straight_approach(
     config: FusionConfig, dwa: DwaPlanner, pose: Pose, command: Command, node: Point,
-    moving, walkers, stalled_before: Point | None,
+    moving, walkers, stalled_before: Point | None, route=None, came_by=(),
 ) -> tuple[Command, np.ndarray] | None:  # fmt: skip
     """The command and predicted path of the straight approach to ``node``, when within
-    ``approach_distance``, no walker is near (``walker_near``; walkers standing still may
-    be, once the AGV stalled before this node: ``stalled_before``) and, driven no faster
-    than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps clear of the
-    map and the moving discs over the horizon; None: DWA drives (and avoids).
+    ``approach_distance``; no walker stands still within ``WALKER_RANGE`` (unless the AGV
+    stalled before this node and every walker in range stands: ``stalled_before``); driven
+    no faster than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps
+    clear of the map and the moving discs over the horizon; and no walker walking on
+    reaches its end before the AGV could yield (``clearance_later``: early yield's test of
+    DWA's samples; a walker against the ``route`` is taken along it and on along
+    ``came_by``). None: DWA drives (and avoids).
 
-    A walker in range keeps the approach off because it stops and turns at the corner,
-    slow to get out of a walker's way. But a walker that stopped where its walk ended may
-    stand there for good, and a 1-cell gap that DWA's arcs cannot thread then failed the
-    run (a walker standing still near the mouth of a narrow gap)."""
+    The approach stops and turns at the corner, slow to get out of a walker's way, so it
+    must leave the room to yield that DWA's samples must leave. A walker standing still
+    may start at any time, and keeps it off within range. With any walker within 12 m
+    instead, DWA's arcs took paper-dynamic's tight corners while its walker was 10 m off:
+    ω bounced in the 1 m passage past (5.5, 3.5) (15 sign changes in 5 s) and the AGV
+    stalled past (11.5, 14.5) in 14 of 21 runs of the walker sweep. But a walker that
+    stopped where its walk ended may stand there for good, and a 1-cell gap that DWA's
+    arcs cannot thread then failed the run (a walker standing still near the mouth of a
+    narrow gap)."""
     if math.dist(pose[:2], node) > config.approach_distance:
         return None
-    if walker_near(pose, walkers) and not _stuck_past_standing(
+    if walker_standing_near(pose, walkers) and not _stuck_past_standing(
         config, stalled_before, node, pose, walkers
     ):
         return None
@@ -89,6 +103,12 @@ def straight_approach(
     path = approach_path(cfg, pose, command, node, cap)
     if dwa.clearance_along(path, moving) <= 0.0:
         return None
+    if walkers is not None and len(walkers):
+        walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
+        speed = math.hypot(command[0], command[1])
+        end_x, end_y = path[-1:, 0], path[-1:, 1]
+        if clearance_later(cfg, end_x, end_y, walkers, speed, route, came_by)[0] <= 0.0:
+            return None
     return approach_command(cfg, pose, command, node, cap), path
 
 

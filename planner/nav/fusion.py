@@ -407,9 +407,11 @@ class FusionController:
         return route_segment(self.behaviour, self.config, self.dwa, segment, pose, moving, walkers)
 
     def _straight_to(self, pose, command, node: Point, moving, walkers):
+        position = (pose[0], pose[1])
         return straight_approach(
-            self.config, self.dwa, pose, command, node, moving, walkers, self._stalled_before
-        )
+            self.config, self.dwa, pose, command, node, moving, walkers, self._stalled_before,
+            [position, *self.key_nodes.ahead()], self.trail.back_from(position),
+        )  # fmt: skip
 
     def _lane_room(self, pose, command, moving, walkers, nodes: list[Point] | None = None):
         corners = self.corners[self.key_nodes.index :]
