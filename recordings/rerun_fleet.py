@@ -27,7 +27,7 @@ TURNING = 0.05  # rad/s: an AGV turning on the spot faster than this drives
 STANDING_S = 1.0
 """s: a driving AGV at rest for less than this still drives. Braking to a tight corner's
 node, it is below ``AT_REST`` for a tick or two before its turn on the spot; counted as
-stopped, the fleet's line dipped for 0.2 s about ten times in a nav2-depot run."""
+stopped, the fleet's line dipped for 0.2 s 16 times in a nav2-depot run."""
 STATES = (("driving", (60, 170, 75)), ("waiting", (255, 160, 0)), ("stopped", (220, 60, 50)))
 ARRIVED_COLOR = (70, 110, 230)
 

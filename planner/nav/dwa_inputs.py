@@ -69,7 +69,7 @@ def lane_room(
 
 def straight_approach(
     config: FusionConfig, dwa: DwaPlanner, pose: Pose, command: Command, node: Point,
-    moving, walkers, stalled_before: Point | None, route=None, came_by=(),
+    moving, walkers, stalled_before: Point | None, route: list[Point], came_by: list[Point],
 ) -> tuple[Command, np.ndarray] | None:  # fmt: skip
     """The command and predicted path of the straight approach to ``node``, when within
     ``approach_distance``; no walker stands still within ``WALKER_RANGE`` (unless the AGV
