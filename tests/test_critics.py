@@ -24,6 +24,7 @@ from planner.local.fallback import Brake, Evade
 from planner.local.filters import Admissible, ArrivalSpeed, NoRetreat, YieldEarly
 from planner.local.samples import Samples
 from planner.local.window import braking_command
+from planner.local.yielding import contact_later
 from planner.maps.distance_field import DistanceField
 from planner.maps.grid import GridMap
 
@@ -186,6 +187,50 @@ def test_yield_early_keeps_to_end_points_off_a_walkers_way():
     narrowed = YieldEarly().narrow(np.ones(2, bool), s, cycle(route=route, walkers=walker))
     assert narrowed.tolist() == [False, True]  # on the route it is met; 2 m aside it is not
     assert YieldEarly().narrow(np.ones(2, bool), s, cycle(route=route)).all()
+
+
+def _aisle(bay: bool = False) -> DistanceField:
+    """A 1 m aisle along y = 10 (0.5 m cells), with a 1 m bay on its north side at x = 11..12."""
+    blocked = np.ones((40, 60), dtype=bool)
+    blocked[19:21, :] = False
+    if bay:
+        blocked[21:23, 22:24] = False
+    return DistanceField.from_grid(GridMap(blocked, 0.5))
+
+
+AISLE_ROUTE, AISLE_CAME_BY = [(10.0, 10.0), (25.0, 10.0)], [(10.0, 10.0), (0.0, 10.0)]
+AISLE_ENDS = [(11.0, 10.0, 0.0), (10.0, 10.0, 0.0), (9.5, 10.0, 0.0), (10.0, 10.3, 0.0)]
+AISLE_COMMANDS = [(0.2, 0.0, 0.0), (0.0, 0.0, 0.0), (-0.1, 0.0, 0.0), (0.0, 0.1, 0.0)]
+
+
+def _yield_in_aisle(walker, bay: bool) -> list[bool]:
+    s = samples(AISLE_COMMANDS, AISLE_ENDS)
+    at = cycle(field=_aisle(bay), route=AISLE_ROUTE, came_by=AISLE_CAME_BY, walkers=walker)
+    return YieldEarly().narrow(np.ones(4, bool), s, at).tolist()
+
+
+def test_with_no_end_point_off_a_walkers_way_and_no_refuge_yield_early_backs_off():
+    # the walker comes head-on at 1 m/s and walks on down the aisle the AGV came by, so
+    # every end point is on its way; at 3 s it is at x = 13
+    walker = np.array([[16.0, 10.0, -1.0, 0.0, 0.3]])
+    s = samples(AISLE_COMMANDS, AISLE_ENDS)
+    contact = contact_later(CFG, s.xs[:, -1], s.ys[:, -1], walker, 0.0, AISLE_ROUTE, AISLE_CAME_BY)
+    # touching at 0.6 m: driving on is met at 4.4 s, standing at 5.4 s, backing off at 5.9 s,
+    # 0.3 m aside (0.52 m along) at 5.48 s
+    assert contact == pytest.approx([4.4, 5.4, 5.9, 5.48], abs=0.1)
+    # the most clearance from its way (the measure before) kept only the step aside, which
+    # the walker reaches as soon as standing: in the aisle the AGV drove on into it
+    assert _yield_in_aisle(walker, bay=False) == [False, False, True, False]
+
+
+def test_with_no_end_point_off_a_walkers_way_yield_early_heads_for_a_refuge_it_reaches_first():
+    # the bay 1.5 m ahead: the AGV gets in (1.6 m from rest: 5.7 s) before a walker at
+    # 1.5 m/s from x = 21 reaches its mouth (6 s): drive on, towards it
+    walker = np.array([[21.0, 10.0, -1.5, 0.0, 0.3]])
+    assert _yield_in_aisle(walker, bay=True) == [True, False, False, False]
+    # a walker at 1 m/s from x = 16 is there first (4.4 s): back off, as with no bay
+    walker = np.array([[16.0, 10.0, -1.0, 0.0, 0.3]])
+    assert _yield_in_aisle(walker, bay=True) == [False, False, True, False]
 
 
 # the profiles and fallbacks --------------------------------------------------------------

@@ -149,13 +149,14 @@ def test_the_evasive_fallback_never_presses_into_a_wall_it_is_pinned_against():
 
 @pytest.mark.parametrize(
     "seed",
-    [3, 40, 42, 50, 211],
+    [3, 40, 42, 50, 211, 854],
     ids=[
         "realistic-walker-turning-aside-among-walls",
         "head-on-walker-turning-off-into-the-bay-the-agv-let-it-by-from",
         "head-on-walker-through-a-one-cell-gap",
         "walker-standing-on-the-route-then-walking-at-the-agv",
         "held-out-head-on-walker-the-agv-backed-off-from-down-its-own-aisle",
+        "held-out-head-on-walker-up-the-one-cell-aisle-the-agv-was-entering",
     ],
 )
 def test_nav_bench_episodes_that_once_ended_in_a_collision(seed):

@@ -25,8 +25,9 @@ import numpy as np
 from planner.core.physics import braking_speed
 from planner.local.cycle import Cycle
 from planner.local.no_retreat import ahead_on_route, retreating
+from planner.local.refuge import REFUGE_SLACK, refuge
 from planner.local.samples import Samples
-from planner.local.yielding import YIELD_SLACK, agvs_of, clearance_later
+from planner.local.yielding import agvs_of, contact_later, yield_horizon
 
 _EPS = 1e-9
 
@@ -71,28 +72,33 @@ class NoRetreat:
 
 @dataclass(frozen=True)
 class YieldEarly:
-    """The samples whose end point no walker reaches before the yield horizon; when no
-    admissible one is such, those that leave the AGV furthest from the walkers' way (it
-    backs off towards a refuge rather than driving on into a walker it can no longer
-    avoid)."""
+    """The samples whose end point no walker reaches before the yield horizon. When no
+    admissible one is such: those that end nearest the refuge (``planner.local.refuge``),
+    the nearest place off the walkers' way the AGV reaches first; with none, those a walker
+    reaches latest, within a control cycle: the AGV backs off along the walker's way rather
+    than driving on into a walker it can no longer avoid."""
 
     name: str = "yield_early"
 
     def narrow(self, mask: np.ndarray, samples: Samples, cycle: Cycle) -> np.ndarray:
-        if cycle.walkers is None or not len(cycle.walkers):
+        if cycle.walkers is None or not len(cycle.walkers) or not mask.any():
             return mask
         cfg, command = cycle.config, cycle.command
         walkers = np.asarray(cycle.walkers, dtype=float).reshape(-1, 5)
         speed = math.hypot(command[0], command[1])
-        later = clearance_later(
-            cfg, samples.xs[:, -1], samples.ys[:, -1], walkers, speed, cycle.route, cycle.came_by
+        end_x, end_y = samples.xs[:, -1], samples.ys[:, -1]
+        contact = contact_later(cfg, end_x, end_y, walkers, speed, cycle.route, cycle.came_by)
+        latest = contact[mask].max()
+        if math.isinf(latest):
+            return mask & np.isinf(contact)
+        horizon = yield_horizon(cfg, speed, float(walkers[:, 4].max()))
+        place = refuge(
+            cfg, cycle.field, cycle.pose[:2], speed, walkers, horizon, cycle.route, cycle.came_by
         )
-        clear = mask & (later > 0.0)
-        if clear.any():
-            return clear
-        if not mask.any():
-            return mask
-        return mask & (later >= later[mask].max() - YIELD_SLACK)
+        if place is None:
+            return mask & (contact >= latest - cfg.dt)
+        near = np.hypot(end_x - place[0], end_y - place[1])
+        return mask & (near <= near[mask].min() + REFUGE_SLACK)
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,9 @@ sideways). So each trajectory is also judged by where it leaves the AGV: if
 it then stood at its end point, would a disc walking on reach it before the
 ``yield_horizon``? DWA keeps to the trajectories that leave the AGV clear
 whenever there are any, and so steps off the walker's way while there is
-still time and room.
+still time and room. When there are none (a one-cell aisle with no refuge in
+reach), it keeps to those a walker reaches last: it backs off along the way
+towards a refuge instead of driving on into the walker.
 
 Where a disc walks on is its ``sweep``: at its known velocity, except that a
 disc on the AGV's remaining route and walking against it is taken to follow
@@ -38,10 +40,6 @@ if TYPE_CHECKING:  # planner.local.dwa imports this module
 YIELD_MARGIN = 2.0
 """The time to brake and step aside, this many times over: a refuge is not always beside
 the AGV."""
-
-YIELD_SLACK = 0.1
-"""m: when no end point is clear of a walker's way, those within this of the furthest from it
-are as good (DWA's score then chooses among them)."""
 
 SWEEP_STEP = 0.1  # m: spacing of the points a sweep is checked at
 ON_ROUTE = 0.5  # m: a disc centre this near the route walks along it
@@ -125,31 +123,37 @@ def sweep(
     return route_samples([start, end], SWEEP_STEP)
 
 
-def parked_clearance(
+def parked_contact(
     end_x: np.ndarray, end_y: np.ndarray, discs: np.ndarray, route: Sequence[Point] | None,
     t_from: float, t_to: float, radius: float, came_by: Sequence[Point] = (),
 ) -> np.ndarray:  # fmt: skip
-    """(N,) the least clearance between an AGV standing at each end point (``end_x``,
-    ``end_y``) and the discs (M, 5) rows [x, y, vx, vy, r] walking on (``sweep``) from
-    ``t_from`` to ``t_to`` (inf: no discs)."""
+    """(N,) the time (s from now) at which the first of the discs (M, 5) rows [x, y, vx, vy,
+    r] walking on (``sweep``) from ``t_from`` to ``t_to`` touches an AGV standing at each
+    end point (``end_x``, ``end_y``); inf where none does."""
     out = np.full(len(end_x), np.inf)
     for disc in discs:
         points = sweep(route, disc, t_from, t_to, came_by)
         gap = np.hypot(end_x[:, None] - points[None, :, 0], end_y[:, None] - points[None, :, 1])
-        out = np.minimum(out, gap.min(axis=1) - disc[4] - radius)
+        touching = gap < disc[4] + radius
+        walked = np.concatenate(([0.0], np.cumsum(np.hypot(*np.diff(points, axis=0).T))))
+        speed = math.hypot(disc[2], disc[3])
+        at = t_from + (walked / speed if speed > 0 else np.zeros_like(walked))
+        first = np.where(touching.any(axis=1), at[touching.argmax(axis=1)], np.inf)
+        out = np.minimum(out, first)
     return out
 
 
-def clearance_later(
+def contact_later(
     config: DwaConfig, end_x: np.ndarray, end_y: np.ndarray, walkers: np.ndarray,
     speed: float, route: Sequence[Point] | None, came_by: Sequence[Point] = (),
 ) -> np.ndarray:  # fmt: skip
-    """(N,) the least clearance between the AGV left standing at each end point of its
-    rollout (``end_x``, ``end_y``) and the ``walkers`` walking on from then until the
-    ``yield_horizon`` (from ``speed``): what early yield asks of DWA's samples
-    (``planner.local.filters.YieldEarly``) and the straight approach of its end."""
+    """(N,) when a walker walking on from the end of the rollout until the ``yield_horizon``
+    (from ``speed``) first touches the AGV left standing at each of its end points
+    (``end_x``, ``end_y``); inf: none does, the end point is off every walker's way. What
+    early yield asks of DWA's samples (``planner.local.filters.YieldEarly``) and the
+    straight approach of its end."""
     horizon = yield_horizon(config, speed, float(walkers[:, 4].max()))
-    return parked_clearance(
+    return parked_contact(
         end_x, end_y, walkers, route, config.horizon_s, horizon, config.radius, came_by
     )
 

@@ -22,7 +22,7 @@ from planner.local.keep_right import agv_coming, right_offset, shifted_right
 from planner.local.lane_speed import oncoming, route_room
 from planner.local.yielding import (
     agvs_of,
-    clearance_later,
+    contact_later,
     walker_near,
     walker_standing_near,
     walkers_standing,
@@ -76,7 +76,7 @@ def straight_approach(
     stalled before this node and every walker in range stands: ``stalled_before``); driven
     no faster than it can brake within its clearance (Eq. 7, as DWA's samples), it keeps
     clear of the map and the moving discs over the horizon; and no walker walking on
-    reaches its end before the AGV could yield (``clearance_later``: early yield's test of
+    reaches its end before the AGV could yield (``contact_later``: early yield's test of
     DWA's samples; a walker against the ``route`` is taken along it and on along
     ``came_by``). None: DWA drives (and avoids).
 
@@ -107,7 +107,7 @@ def straight_approach(
         walkers = np.asarray(walkers, dtype=float).reshape(-1, 5)
         speed = math.hypot(command[0], command[1])
         end_x, end_y = path[-1:, 0], path[-1:, 1]
-        if clearance_later(cfg, end_x, end_y, walkers, speed, route, came_by)[0] <= 0.0:
+        if contact_later(cfg, end_x, end_y, walkers, speed, route, came_by)[0] < math.inf:
             return None
     return approach_command(cfg, pose, command, node, cap), path
 
