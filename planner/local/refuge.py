@@ -3,13 +3,13 @@
 Early yield (``planner.local.filters.YieldEarly``) keeps DWA to the samples whose end
 point no walker reaches. In a one-cell lane none is, and which of them DWA drives decides
 where the AGV goes. No measure of the end points alone is right: the most clearance from
-the walker's way drove on into the walker up a one-cell aisle (nav_bench seed 854); the
-latest contact backed the AGV away from a bay just ahead of it into the lane's dead end
-(``tests/test_local_planner.py``, the bay walker). The refuge says where to go instead:
-the nearest place the AGV fits, off every walker's way until the yield horizon, that it
-reaches before a walker does. It is found by a wavefront from the AGV over a lattice of
-the places it fits, which a walker must not overtake: a place counts as reached only if
-the AGV, starting from rest there at ``max_accel``, gets there before a walker touches it.
+the walker's way is the same for every end point in the lane, so DWA drove on into a
+walker coming down it; the latest contact backs the AGV away from a bay just ahead, into
+the lane's dead end. The refuge says where to go instead: the nearest place the AGV fits,
+off every walker's way until the yield horizon, that it reaches before a walker does. It
+is found by a wavefront from the AGV over a lattice of the places it fits, which a walker
+must not overtake: a place counts as reached only if the AGV, braking and then going from rest at
+``max_accel``, gets there before a walker touches it.
 """
 
 from __future__ import annotations
